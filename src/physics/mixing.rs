@@ -1,0 +1,1 @@
+//! Material mixing rules.

@@ -1,0 +1,233 @@
+//! Pure contact laws, one file per deck keyword, grouped by model axis like
+//! LIGGGHTS `pair_style gran`: `normal/`, `tangential/`, `cohesion/`,
+//! `rolling/`. Laws read a read-only [`Contact`] and the pair's
+//! [`PairParams`], own a slice of per-contact history, and add their part to a
+//! [`ContactOut`]. The order is written down once, in
+//! [`crate::engine::kernel`]: normal -> cohesion -> tangential -> rolling.
+//!
+//! Sign conventions (as LAMMPS `pair_gran_*`): `n` points from j to i,
+//! `delta > 0` is overlap, `vn = (v_i - v_j) . n` is negative while the
+//! spheres approach, `fn_total > 0` pushes i away from j. The force on i is
+//! `fn_total * n + ft`; j gets the opposite force.
+//!
+//! Units: SI inside (or whatever consistent set the deck's `units` gives; the
+//! laws are unit-agnostic).
+
+pub mod normal;
+pub mod tangential;
+pub mod cohesion;
+pub mod rolling;
+pub mod mixing;
+
+use nalgebra::Vector3;
+
+/// 3-vector of f64.
+pub type V3 = Vector3<f64>;
+
+/// Geometry and kinematics of one contact at one step (pair or particle-wall).
+#[derive(Clone, Copy, Debug)]
+pub struct Contact {
+    /// Unit normal from j (or the wall) to i.
+    pub n: V3,
+    /// Centre distance (wall: distance from centre to the wall's contact point).
+    pub r: f64,
+    /// Overlap `ri + rj - r` (> 0 in contact; < 0 apart, for non-contact cohesion).
+    pub delta: f64,
+    /// Radius of i.
+    pub ri: f64,
+    /// Radius of j (`f64::INFINITY` for walls).
+    pub rj: f64,
+    /// Effective radius R* = ri rj / (ri + rj) (walls: ri).
+    pub r_eff: f64,
+    /// Mass of i.
+    pub mi: f64,
+    /// Mass of j (`f64::INFINITY` for walls and frozen particles).
+    pub mj: f64,
+    /// Effective mass m* (walls, frozen partners: the mobile particle's mass).
+    pub m_eff: f64,
+    /// Relative centre velocity v_i - v_j (walls: v_i - v_wall at the contact point).
+    pub vr: V3,
+    /// Normal relative speed `vr . n` (negative approaching).
+    pub vn: f64,
+    /// Angular velocity of i.
+    pub wi: V3,
+    /// Angular velocity of j (zero for static walls).
+    pub wj: V3,
+    /// Time step.
+    pub dt: f64,
+}
+
+impl Contact {
+    /// Whether the surfaces touch.
+    #[inline(always)]
+    pub fn touching(&self) -> bool {
+        self.delta > 0.0
+    }
+    /// Wall contact (j has infinite radius).
+    #[inline(always)]
+    pub fn is_wall(&self) -> bool {
+        self.rj.is_infinite()
+    }
+}
+
+/// What the laws of one contact produce, filled in order
+/// normal -> cohesion -> tangential -> rolling.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ContactOut {
+    /// Elastic normal force magnitude (along n, > 0 repulsive).
+    pub fn_elastic: f64,
+    /// Damping normal force (along n).
+    pub fn_damp: f64,
+    /// Cohesive normal force (along n, < 0 attractive).
+    pub fn_coh: f64,
+    /// Normal force the friction cap uses (law-dependent: LIGGGHTS uses the
+    /// contact force without cohesion; LAMMPS JKR/DMT use Fne + 2 F_pulloff).
+    pub fn_for_friction: f64,
+    /// Current normal stiffness (dF/d delta for Hooke; the law's k_n for Hertz),
+    /// for rolling models that scale with it.
+    pub kn: f64,
+    /// Current tangential stiffness.
+    pub kt: f64,
+    /// Contact radius `a` where the law defines one (Hertz: sqrt(R* delta)).
+    pub a: f64,
+    /// Tangential force on i.
+    pub ft: V3,
+    /// Torque on i.
+    pub torque_i: V3,
+    /// Torque on j.
+    pub torque_j: V3,
+}
+
+impl ContactOut {
+    /// Total normal force magnitude along n.
+    #[inline(always)]
+    pub fn fn_total(&self) -> f64 {
+        self.fn_elastic + self.fn_damp + self.fn_coh
+    }
+    /// Total force on i.
+    #[inline(always)]
+    pub fn force_i(&self, c: &Contact) -> V3 {
+        c.n * self.fn_total() + self.ft
+    }
+}
+
+/// Coefficients of one type pair (or particle type and wall type), filled at
+/// scene build from `fix property/global`, `pair_coeff` or `pair_style`
+/// arguments. A law reads only the fields it needs; the rest stay zero.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct PairParams {
+    /// Effective Young's modulus Y* (LIGGGHTS mixing, or LAMMPS E_eff).
+    pub y_eff: f64,
+    /// Effective shear modulus G*.
+    pub g_eff: f64,
+    /// Coefficient of restitution (LIGGGHTS `coefficientRestitution`).
+    pub restitution: f64,
+    /// beta = ln e / sqrt(ln^2 e + pi^2) (LIGGGHTS damping), < 0.
+    pub beta: f64,
+    /// Sliding friction coefficient mu.
+    pub mu: f64,
+    /// Rolling friction coefficient mu_r.
+    pub mu_r: f64,
+    /// Rolling viscous damping coefficient (epsd, epsd3).
+    pub eta_r: f64,
+    /// Rolling stiffness coefficient (epsd3 `coeffRollingStiffness`, 2.25 for epsd).
+    pub k_r_coeff: f64,
+    /// Cohesion energy density (sjkr, sjkr2), J/m^3; or surface energy gamma
+    /// (vdw, dmt, jkr), J/m^2.
+    pub cohesion: f64,
+    /// Characteristic velocity (LIGGGHTS hooke).
+    pub char_vel: f64,
+    /// Normal stiffness constant (Hooke kn, LAMMPS Kn, LIGGGHTS `kn`).
+    pub kn: f64,
+    /// Tangential stiffness constant.
+    pub kt: f64,
+    /// Normal damping constant (meaning depends on the law).
+    pub gamma_n: f64,
+    /// Tangential damping constant.
+    pub gamma_t: f64,
+    /// Whether tangential damping is on (LIGGGHTS `tangential_damping`,
+    /// LAMMPS `dampflag`): 1.0 or 0.0.
+    pub tangential_damping: f64,
+    /// Rolling stiffness (LAMMPS rolling sds k_roll).
+    pub k_roll: f64,
+    /// Rolling damping (LAMMPS rolling sds gamma_roll).
+    pub gamma_roll: f64,
+    /// Twisting stiffness, damping and friction (LAMMPS twisting sds).
+    pub k_twist: f64,
+    /// Twisting damping.
+    pub gamma_twist: f64,
+    /// Twisting friction coefficient.
+    pub mu_twist: f64,
+    /// Van der Waals: Hamaker constant A_H.
+    pub hamaker: f64,
+    /// Van der Waals: minimum separation D_min.
+    pub d_min: f64,
+    /// Van der Waals: cut-off separation D_max.
+    pub d_max: f64,
+    /// Viscoelastic dissipative constant A_n (paper Eq. 10).
+    pub a_n: f64,
+    /// Poisson ratio of the pair (where a law needs it alone).
+    pub poisson: f64,
+    /// Extra range beyond contact over which the pair interacts (vdW D_max,
+    /// JKR pull-off distance); the neighbour cut-off adds it.
+    pub extra_range: f64,
+    /// Whether `limit_damping` (LAMMPS) / `limitForce` (LIGGGHTS) is on: 1.0 or 0.0.
+    pub limit_damping: f64,
+}
+
+/// A normal force law.
+pub trait NormalLaw: Sync {
+    /// History values this law keeps per contact.
+    const HISTORY: usize;
+    /// Whether the law acts only when the surfaces touch.
+    const CONTACT_ONLY: bool = true;
+    /// Fill `fn_elastic`, `fn_damp`, `fn_for_friction`, `kn`, `kt`, `a`.
+    fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+}
+
+/// A tangential (friction) law. Also applies the torque of the tangential
+/// force, with its engine's lever arm convention.
+pub trait TangentialLaw: Sync {
+    /// History values per contact.
+    const HISTORY: usize;
+    /// Fill `ft`, add to `torque_i`, `torque_j`.
+    fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+}
+
+/// A cohesion law (adds to `fn_coh`).
+pub trait CohesionLaw: Sync {
+    /// History values per contact.
+    const HISTORY: usize;
+    /// Whether it acts on pairs that do not touch (vdW): the neighbour list
+    /// and the kernel then include them.
+    const NONCONTACT: bool;
+    /// Add the cohesive normal force.
+    fn cohesion(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+}
+
+/// A rolling (and twisting) resistance law (adds torques).
+pub trait RollingLaw: Sync {
+    /// History values per contact.
+    const HISTORY: usize;
+    /// Add rolling/twisting torques to `torque_i` / `torque_j`.
+    fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+}
+
+/// No cohesion: a zero-sized type, compiled away.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoCohesion;
+impl CohesionLaw for NoCohesion {
+    const HISTORY: usize = 0;
+    const NONCONTACT: bool = false;
+    #[inline(always)]
+    fn cohesion(&self, _: &Contact, _: &PairParams, _: &mut [f64], _: &mut ContactOut) {}
+}
+
+/// No rolling resistance: a zero-sized type, compiled away.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoRolling;
+impl RollingLaw for NoRolling {
+    const HISTORY: usize = 0;
+    #[inline(always)]
+    fn rolling(&self, _: &Contact, _: &PairParams, _: &mut [f64], _: &mut ContactOut) {}
+}
