@@ -11,6 +11,7 @@
 pub mod error;
 pub mod script;
 pub mod physics;
+pub mod geom;
 pub mod engine;
 pub mod scene;
 pub mod io;

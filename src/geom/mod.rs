@@ -1,0 +1,1 @@
+//! Geometry: regions, lattices, triangle meshes, primitive wall shapes (in progress).
