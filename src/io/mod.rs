@@ -1,1 +1,3 @@
-//! io (in progress).
+//! Reading and writing the files LIGGGHTS and LAMMPS read and write: text
+//! dumps (plain or gzip), data files, VTK, and printf-style number formats.
+pub mod cfmt;
