@@ -198,8 +198,8 @@ mod tests {
         let start = "units si\npair_style gran model hertz cohesion ".len();
         let e = Error::deck_hint(Span::new(id, start, start + 4), "unknown cohesion model 'sjrk'", "did you mean 'sjkr'?");
         let r = e.render(&map);
-        assert!(r.starts_with("in.pour:2:39: error: unknown cohesion model 'sjrk'\n"), "{r}");
-        assert!(r.contains("\n  |                                       ^^^^\n"), "{r}");
+        assert!(r.starts_with("in.pour:2:38: error: unknown cohesion model 'sjrk'\n"), "{r}");
+        assert!(r.contains("\n  |                                      ^^^^\n"), "{r}");
         assert_eq!(e.exit_code(), 2);
     }
 

@@ -1,1 +1,7 @@
-//! engine (in progress).
+//! The engine: particles (structure of arrays), domain, neighbour list with
+//! contact history, the contact kernel, integration, fixes and the run loop.
+pub mod particles;
+pub mod domain;
+pub mod neighbor;
+pub mod kernel;
+pub mod integrate;

@@ -1,0 +1,492 @@
+//! Binned Verlet pair list with skin, and contact history that survives
+//! rebuilds (LIGGGHTS `neighbor 0.002 bin`, `fix contact_history`).
+//!
+//! Each pair is stored once (a half list) with the particle of the smaller id
+//! first, so per-contact history always has the same orientation whatever the
+//! storage order; periodic images are an explicit shift of the second
+//! particle. History is carried across rebuilds keyed by the two ids.
+//! Per-particle adjacency (CSR) lists each particle's pairs in increasing pair
+//! index, so forces can be gathered in a fixed order on any thread count.
+
+use super::domain::Domain;
+use super::particles::Particles;
+use crate::physics::V3;
+use std::collections::HashMap;
+
+/// The half pair list with history.
+#[derive(Clone, Debug, Default)]
+pub struct PairList {
+    /// First particle (smaller id) of each pair.
+    pub a: Vec<u32>,
+    /// Second particle.
+    pub b: Vec<u32>,
+    /// Periodic shift added to b's position: b is seen at `x[b] + shift`.
+    pub shift: Vec<V3>,
+    /// History values, `width` per pair.
+    pub hist: Vec<f64>,
+    /// History values per pair.
+    pub width: usize,
+    /// CSR offsets into `adj` per particle (len = n + 1).
+    pub adj_start: Vec<u32>,
+    /// For each particle, its pairs in increasing pair index; the high bit
+    /// marks pairs where the particle is `b`.
+    pub adj: Vec<u32>,
+    /// Ids of (a, b) at the last build: history is matched by these.
+    pub keys: Vec<(i64, i64)>,
+    /// Positions at the last build (for the skin check).
+    pub x_built: Vec<V3>,
+    /// Step of the last build.
+    pub last_build: i64,
+    /// Number of builds so far.
+    pub builds: u64,
+    /// Number of dangerous builds (a particle had moved more than half the
+    /// skin when the list was rebuilt on schedule).
+    pub dangerous: u64,
+}
+
+/// Marker bit in `PairList::adj` for "this particle is b".
+pub const ADJ_B: u32 = 1 << 31;
+
+/// Neighbour settings (LAMMPS `neighbor`, `neigh_modify`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct NeighSettings {
+    /// Skin distance.
+    pub skin: f64,
+    /// `delay` steps since the last build before a new one is considered.
+    pub delay: i64,
+    /// Consider a build every this many steps.
+    pub every: i64,
+    /// Build only if some particle moved more than half the skin.
+    pub check: bool,
+    /// `neigh_modify exclude type I J` pairs (unordered).
+    pub exclude_types: Vec<(u32, u32)>,
+    /// `neigh_modify exclude group g1 g2` as mask bits.
+    pub exclude_groups: Vec<(u32, u32)>,
+}
+
+impl Default for NeighSettings {
+    fn default() -> Self {
+        // LAMMPS defaults: skin 0.3 sigma (lj) / 0.001 m (si); delay 0 every 1
+        // check yes (since 2020; LIGGGHTS wants delay 0 too).
+        NeighSettings { skin: 0.001, delay: 0, every: 1, check: true, exclude_types: vec![], exclude_groups: vec![] }
+    }
+}
+
+impl NeighSettings {
+    fn excluded(&self, p: &Particles, i: usize, j: usize) -> bool {
+        let (ti, tj) = (p.kind[i], p.kind[j]);
+        for &(a, b) in &self.exclude_types {
+            if (a == ti && b == tj) || (a == tj && b == ti) {
+                return true;
+            }
+        }
+        for &(ga, gb) in &self.exclude_groups {
+            let (mi, mj) = (p.mask[i], p.mask[j]);
+            if (mi & ga != 0 && mj & gb != 0) || (mi & gb != 0 && mj & ga != 0) {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+impl PairList {
+    /// Number of pairs.
+    pub fn len(&self) -> usize {
+        self.a.len()
+    }
+    /// Whether there are no pairs.
+    pub fn is_empty(&self) -> bool {
+        self.a.is_empty()
+    }
+
+    /// Whether a rebuild is due at `step` (LAMMPS `Neighbor::decide`).
+    pub fn needs_rebuild(&mut self, p: &Particles, s: &NeighSettings, step: i64) -> bool {
+        if self.x_built.len() != p.len() {
+            return true;
+        }
+        let since = step - self.last_build;
+        if since < s.delay || (s.every > 0 && since % s.every != 0) {
+            return false;
+        }
+        if !s.check {
+            return true;
+        }
+        let lim = 0.25 * s.skin * s.skin;
+        let moved = p.x.iter().zip(&self.x_built).any(|(x, x0)| (x - x0).norm_squared() > lim);
+        if moved && since == s.delay.max(1) && s.delay > 0 {
+            self.dangerous += 1;
+        }
+        moved
+    }
+
+    /// Build the list. `range(i, j)` is how far beyond touching the pair
+    /// interacts (0 for contact-only models). History of pairs present before
+    /// is carried over by id.
+    pub fn build<F>(&mut self, p: &Particles, dom: &Domain, s: &NeighSettings, step: i64, width: usize, extra_range: F)
+    where
+        F: Fn(usize, usize) -> f64,
+    {
+        let n = p.len();
+        // --- carry old history by id pair
+        let mut old: HashMap<(i64, i64), usize> = HashMap::new();
+        if self.width == width && width > 0 {
+            for k in 0..self.a.len() {
+                let h = &self.hist[k * width..(k + 1) * width];
+                if h.iter().any(|&v| v != 0.0) {
+                    if let Some(&key) = self.keys.get(k) {
+                        old.insert(key, k);
+                    }
+                }
+            }
+        }
+        let old_hist = std::mem::take(&mut self.hist);
+
+        self.a.clear();
+        self.b.clear();
+        self.shift.clear();
+        self.width = width;
+
+        if n > 0 {
+            let rmax = p.radius.iter().cloned().fold(0.0, f64::max);
+            let mut emax: f64 = 0.0;
+            // extra range is per type pair; sample the maximum over present types
+            let mut types: Vec<u32> = p.kind.clone();
+            types.sort_unstable();
+            types.dedup();
+            let mut rep: Vec<usize> = Vec::new();
+            for &t in &types {
+                if let Some(i) = p.kind.iter().position(|&k| k == t) {
+                    rep.push(i);
+                }
+            }
+            for &i in &rep {
+                for &j in &rep {
+                    emax = emax.max(extra_range(i, j));
+                }
+            }
+            let cut = 2.0 * rmax + s.skin + emax;
+            let grid = Grid::new(p, dom, cut);
+            let lens = dom.lengths();
+            for i in 0..n {
+                let ci = grid.cell_of(&p.x[i]);
+                for dz in -1i64..=1 {
+                    for dy in -1i64..=1 {
+                        for dx in -1i64..=1 {
+                            let Some((cell, sh)) = grid.neighbor_cell(ci, [dx, dy, dz]) else { continue };
+                            let shift = V3::new(sh[0] as f64 * lens[0], sh[1] as f64 * lens[1], sh[2] as f64 * lens[2]);
+                            for &j in grid.members(cell) {
+                                let j = j as usize;
+                                let self_image = i == j;
+                                if j < i || (self_image && !positive(sh)) {
+                                    continue;
+                                }
+                                let d = p.x[i] - (p.x[j] + shift);
+                                let reach = p.radius[i] + p.radius[j] + s.skin + extra_range(i, j);
+                                if d.norm_squared() >= reach * reach {
+                                    continue;
+                                }
+                                if !self_image && s.excluded(p, i, j) {
+                                    continue;
+                                }
+                                // smaller id first; the shift applies to the second
+                                if p.tag[i] <= p.tag[j] {
+                                    self.a.push(i as u32);
+                                    self.b.push(j as u32);
+                                    self.shift.push(shift);
+                                } else {
+                                    self.a.push(j as u32);
+                                    self.b.push(i as u32);
+                                    self.shift.push(-shift);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // deterministic pair order: by (a, b) storage index, then shift
+        let m = self.a.len();
+        let mut order: Vec<usize> = (0..m).collect();
+        order.sort_by(|&u, &v| {
+            (self.a[u], self.b[u])
+                .cmp(&(self.a[v], self.b[v]))
+                .then_with(|| cmp_v3(&self.shift[u], &self.shift[v]))
+        });
+        self.a = order.iter().map(|&k| self.a[k]).collect();
+        self.b = order.iter().map(|&k| self.b[k]).collect();
+        self.shift = order.iter().map(|&k| self.shift[k]).collect();
+
+        self.keys = (0..m).map(|k| (p.tag[self.a[k] as usize], p.tag[self.b[k] as usize])).collect();
+        // history
+        self.hist = vec![0.0; m * width];
+        if !old.is_empty() {
+            for k in 0..m {
+                if let Some(&ok) = old.get(&self.keys[k]) {
+                    self.hist[k * width..(k + 1) * width].copy_from_slice(&old_hist[ok * width..(ok + 1) * width]);
+                }
+            }
+        }
+        // adjacency (CSR), pairs in increasing index per particle
+        let mut count = vec![0u32; n + 1];
+        for k in 0..m {
+            count[self.a[k] as usize + 1] += 1;
+            count[self.b[k] as usize + 1] += 1;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        self.adj = vec![0; 2 * m];
+        for k in 0..m {
+            let a = self.a[k] as usize;
+            let b = self.b[k] as usize;
+            self.adj[fill[a] as usize] = k as u32;
+            fill[a] += 1;
+            self.adj[fill[b] as usize] = k as u32 | ADJ_B;
+            fill[b] += 1;
+        }
+        self.adj_start = count;
+        self.x_built = p.x.clone();
+        self.last_build = step;
+        self.builds += 1;
+    }
+
+    /// Forget all pairs and history (after particles were reordered or removed
+    /// the list must be rebuilt before use; history is kept by id).
+    pub fn invalidate(&mut self) {
+        self.x_built.clear();
+    }
+}
+
+fn positive(sh: [i64; 3]) -> bool {
+    // lexicographically positive shift: (0,0,0) is not
+    for d in (0..3).rev() {
+        if sh[d] != 0 {
+            return sh[d] > 0;
+        }
+    }
+    false
+}
+
+fn cmp_v3(a: &V3, b: &V3) -> std::cmp::Ordering {
+    for d in 0..3 {
+        match a[d].partial_cmp(&b[d]) {
+            Some(std::cmp::Ordering::Equal) | None => continue,
+            Some(o) => return o,
+        }
+    }
+    std::cmp::Ordering::Equal
+}
+
+/// Uniform bins over the box (particles outside non-periodic sides go to the
+/// edge bins).
+struct Grid {
+    lo: [f64; 3],
+    size: [f64; 3],
+    dims: [i64; 3],
+    periodic: [bool; 3],
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Grid {
+    fn new(p: &Particles, dom: &Domain, cut: f64) -> Grid {
+        let mut lo = [0.0; 3];
+        let mut size = [0.0; 3];
+        let mut dims = [1i64; 3];
+        let mut periodic = [false; 3];
+        for d in 0..3 {
+            periodic[d] = dom.periodic(d);
+            let (mut a, mut b) = (dom.lo[d], dom.hi[d]);
+            if !periodic[d] {
+                for x in &p.x {
+                    a = a.min(x[d]);
+                    b = b.max(x[d]);
+                }
+            }
+            let len = (b - a).max(cut);
+            let nb = ((len / cut).floor() as i64).clamp(1, 1 << 10);
+            lo[d] = a;
+            dims[d] = nb;
+            size[d] = len / nb as f64;
+        }
+        // cap the total number of bins to a few per particle
+        let mut total = dims[0] * dims[1] * dims[2];
+        let cap = (8 * p.len() as i64).max(64);
+        while total > cap {
+            for d in 0..3 {
+                if dims[d] > 1 && !(periodic[d] && dims[d] <= 3) {
+                    let len = size[d] * dims[d] as f64;
+                    dims[d] = (dims[d] / 2).max(1);
+                    size[d] = len / dims[d] as f64;
+                }
+            }
+            let nt = dims[0] * dims[1] * dims[2];
+            if nt == total {
+                break;
+            }
+            total = nt;
+        }
+        let mut g = Grid { lo, size, dims, periodic, start: vec![], items: vec![] };
+        let ncell = (dims[0] * dims[1] * dims[2]) as usize;
+        let cells: Vec<usize> = p.x.iter().map(|x| g.index(g.cell_of(x))).collect();
+        let mut count = vec![0u32; ncell + 1];
+        for &c in &cells {
+            count[c + 1] += 1;
+        }
+        for c in 0..ncell {
+            count[c + 1] += count[c];
+        }
+        let mut fill = count.clone();
+        let mut items = vec![0u32; p.len()];
+        for (i, &c) in cells.iter().enumerate() {
+            items[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        }
+        g.start = count;
+        g.items = items;
+        g
+    }
+    fn cell_of(&self, x: &V3) -> [i64; 3] {
+        let mut c = [0i64; 3];
+        for d in 0..3 {
+            let mut k = ((x[d] - self.lo[d]) / self.size[d]).floor() as i64;
+            if self.periodic[d] {
+                k = k.rem_euclid(self.dims[d]);
+            } else {
+                k = k.clamp(0, self.dims[d] - 1);
+            }
+            c[d] = k;
+        }
+        c
+    }
+    fn index(&self, c: [i64; 3]) -> usize {
+        ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
+    }
+    /// Neighbour cell at offset, with the periodic image shift of its members.
+    fn neighbor_cell(&self, c: [i64; 3], off: [i64; 3]) -> Option<(usize, [i64; 3])> {
+        let mut n = [0i64; 3];
+        let mut sh = [0i64; 3];
+        for d in 0..3 {
+            let k = c[d] + off[d];
+            if self.periodic[d] {
+                let w = k.rem_euclid(self.dims[d]);
+                sh[d] = (k - w) / self.dims[d];
+                n[d] = w;
+            } else {
+                if k < 0 || k >= self.dims[d] {
+                    return None;
+                }
+                n[d] = k;
+            }
+        }
+        // with fewer than 3 bins, different offsets must not revisit the same
+        // (cell, shift): they cannot, since the shift differs.
+        Some((self.index(n), sh))
+    }
+    fn members(&self, cell: usize) -> &[u32] {
+        &self.items[self.start[cell] as usize..self.start[cell + 1] as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::domain::Side;
+    use super::super::particles::NewParticle;
+    use super::*;
+
+    fn part(tag: i64, x: V3, r: f64) -> NewParticle {
+        NewParticle { tag, kind: 1, mask: 1, x, v: V3::zeros(), omega: V3::zeros(), radius: r, density: 1.0 }
+    }
+
+    /// Brute-force all (i, j, image) pairs within reach.
+    fn brute(p: &Particles, dom: &Domain, skin: f64) -> Vec<(i64, i64, [i64; 3])> {
+        let mut out = vec![];
+        let l = dom.lengths();
+        for i in 0..p.len() {
+            for j in i..p.len() {
+                for sx in -1..=1i64 {
+                    for sy in -1..=1i64 {
+                        for sz in -1..=1i64 {
+                            let sh = [sx, sy, sz];
+                            if (0..3).any(|d| sh[d] != 0 && !dom.periodic(d)) {
+                                continue;
+                            }
+                            if i == j && !positive(sh) {
+                                continue;
+                            }
+                            let s = V3::new(sx as f64 * l[0], sy as f64 * l[1], sz as f64 * l[2]);
+                            let d = p.x[i] - (p.x[j] + s);
+                            if d.norm() < p.radius[i] + p.radius[j] + skin {
+                                let (ta, tb, sh) = if p.tag[i] <= p.tag[j] { (p.tag[i], p.tag[j], sh) } else { (p.tag[j], p.tag[i], [-sx, -sy, -sz]) };
+                                out.push((ta, tb, sh));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+
+    #[test]
+    fn binned_list_equals_brute_force_with_periodic_images() {
+        let sides = [[Side::Periodic; 2], [Side::Periodic; 2], [Side::Fixed; 2]];
+        let dom = Domain::new([0.0; 3], [4.0, 2.5, 6.0], sides, 3);
+        let mut p = Particles::default();
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for t in 0..300 {
+            let x = V3::new(4.0 * rnd(), 2.5 * rnd(), 6.0 * rnd());
+            p.push(part(1000 - t, x, 0.2 + 0.1 * rnd()));
+        }
+        let s = NeighSettings { skin: 0.1, ..Default::default() };
+        let mut pl = PairList::default();
+        pl.build(&p, &dom, &s, 0, 2, |_, _| 0.0);
+        let l = dom.lengths();
+        let mut got: Vec<(i64, i64, [i64; 3])> = (0..pl.len())
+            .map(|k| {
+                let sh = pl.shift[k];
+                let c = [(sh[0] / l[0]).round() as i64, (sh[1] / l[1]).round() as i64, (sh[2] / l[2]).round() as i64];
+                (p.tag[pl.a[k] as usize], p.tag[pl.b[k] as usize], c)
+            })
+            .collect();
+        got.sort();
+        assert_eq!(got, brute(&p, &dom, 0.1));
+        assert!(!got.is_empty());
+        // every pair appears twice in the adjacency, in increasing pair order
+        assert_eq!(pl.adj.len(), 2 * pl.len());
+        for i in 0..p.len() {
+            let s = &pl.adj[pl.adj_start[i] as usize..pl.adj_start[i + 1] as usize];
+            assert!(s.windows(2).all(|w| (w[0] & !ADJ_B) < (w[1] & !ADJ_B)));
+        }
+    }
+
+    #[test]
+    fn history_follows_ids_across_rebuild_and_reorder() {
+        let sides = [[Side::Fixed; 2]; 3];
+        let dom = Domain::new([0.0; 3], [10.0; 3], sides, 3);
+        let mut p = Particles::default();
+        p.push(part(7, V3::new(1.0, 1.0, 1.0), 0.5));
+        p.push(part(3, V3::new(1.9, 1.0, 1.0), 0.5));
+        p.push(part(5, V3::new(5.0, 5.0, 5.0), 0.5));
+        let s = NeighSettings::default();
+        let mut pl = PairList::default();
+        pl.build(&p, &dom, &s, 0, 3, |_, _| 0.0);
+        assert_eq!(pl.len(), 1);
+        assert_eq!(p.tag[pl.a[0] as usize], 3); // smaller id first
+        pl.hist.copy_from_slice(&[1.0, 2.0, 3.0]);
+        p.permute(&[2, 1, 0]);
+        pl.build(&p, &dom, &s, 10, 3, |_, _| 0.0);
+        assert_eq!(pl.len(), 1);
+        assert_eq!(p.tag[pl.a[0] as usize], 3);
+        assert_eq!(pl.hist, vec![1.0, 2.0, 3.0]);
+    }
+}
