@@ -1,5 +1,182 @@
-//! Command line (in progress).
+//! The command line: `demx run`, `demx check`, `demx dump info`, and the
+//! later subcommands. Parses arguments, runs, and maps the result to an exit
+//! code in one place.
+
+use crate::error::{Error, Result};
+use crate::scene::{summary::Summary, Session};
+use crate::script::{Interpreter, SourceMap};
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// demx: DEM engine and validator for LIGGGHTS/LAMMPS granular decks.
+#[derive(Parser, Debug)]
+#[command(name = "demx", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+/// Variables and deck shared by run and check.
+#[derive(Args, Debug, Clone)]
+pub struct DeckArgs {
+    /// The deck (input script).
+    pub deck: PathBuf,
+    /// `-var NAME VALUE ...` (also `-v`), as LAMMPS takes them.
+    #[arg(long = "var", short = 'v', num_args = 2.., value_names = ["NAME", "VALUE"], action = clap::ArgAction::Append, allow_hyphen_values = true)]
+    pub var: Vec<Vec<String>>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Cmd {
+    /// Run a deck natively.
+    Run {
+        #[command(flatten)]
+        deck: DeckArgs,
+        /// Worker threads (results are bitwise identical for any count).
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        /// Log file (`none` for no log), as LAMMPS `-log`.
+        #[arg(long = "log", default_value = "log.demx")]
+        log: String,
+        /// No thermo output on the screen.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Read and validate a deck without running it; print a summary.
+    Check {
+        #[command(flatten)]
+        deck: DeckArgs,
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Dump file tools.
+    Dump {
+        #[command(subcommand)]
+        what: DumpCmd,
+    },
+    /// Compare demx with LIGGGHTS/LAMMPS (not implemented yet).
+    Compare {
+        /// Inputs.
+        #[arg(num_args = 0..)]
+        inputs: Vec<String>,
+    },
+    /// Run the real engine on a deck (not implemented yet).
+    Reference {
+        /// Inputs.
+        #[arg(num_args = 0..)]
+        inputs: Vec<String>,
+    },
+    /// Convert legacy decks / dialects (not implemented yet).
+    Convert {
+        /// Inputs.
+        #[arg(num_args = 0..)]
+        inputs: Vec<String>,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum DumpCmd {
+    /// List frames, atoms and columns of a dump file.
+    Info {
+        /// The dump file (plain or gzip).
+        file: PathBuf,
+    },
+}
+
+fn cli_vars(d: &DeckArgs) -> Vec<(String, Vec<String>)> {
+    d.var.iter().filter(|v| !v.is_empty()).map(|v| (v[0].clone(), v[1..].to_vec())).collect()
+}
+
+/// Translate LAMMPS-style single-dash options (`-var`, `-v`, `-log`, `-in`)
+/// into clap's double-dash form, so `demx run in.x -var d 1e-3` works.
+fn normalise_args(args: Vec<String>) -> Vec<String> {
+    args.into_iter()
+        .map(|a| match a.as_str() {
+            "-var" => "--var".to_string(),
+            "-log" => "--log".to_string(),
+            "-in" => "--in".to_string(),
+            _ => a,
+        })
+        .collect()
+}
+
+/// Run a deck in a session; returns the session (for summaries) or the error
+/// with the source map to render it.
+pub fn run_deck(deck: &DeckArgs, check: bool, threads: usize, log: Option<&str>, quiet: bool) -> (Session, SourceMap, Result<()>) {
+    let sources = SourceMap::new();
+    let mut session = Session::new(check);
+    session.threads = threads;
+    if check || quiet {
+        session.sim.log.screen = false;
+    }
+    if let Some(l) = log.filter(|l| *l != "none") {
+        if let Err(e) = session.sim.log.open(l, false) {
+            return (session, sources, Err(Error::io(crate::script::Span::DUMMY, format!("cannot open log file '{l}'"), &e)));
+        }
+    }
+    let mut interp = Interpreter::new(sources.clone(), cli_vars(deck));
+    if check {
+        interp.set_command_limit(2_000_000);
+    }
+    let r = interp.run_file(&deck.deck, &mut session);
+    (session, sources, r)
+}
+
+fn report(err: &Error, sources: &SourceMap) -> ExitCode {
+    eprint!("{}", err.render(sources));
+    ExitCode::from(err.exit_code())
+}
+
 /// Entry point.
-pub fn main() -> std::process::ExitCode {
-    std::process::ExitCode::SUCCESS
+pub fn main() -> ExitCode {
+    let args = normalise_args(std::env::args().collect());
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    match cli.cmd {
+        Cmd::Run { deck, threads, log, quiet } => {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build_global();
+            if pool.is_err() {
+                eprintln!("warning: thread pool already initialised");
+            }
+            let (_s, sources, r) = run_deck(&deck, false, threads, Some(&log), quiet);
+            match r {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => report(&e, &sources),
+            }
+        }
+        Cmd::Check { deck, json } => {
+            let (s, sources, r) = run_deck(&deck, true, 1, None, true);
+            match r {
+                Ok(()) => {
+                    let sum = Summary::of(&s);
+                    if json {
+                        println!("{}", serde_json::to_string_pretty(&sum).unwrap_or_default());
+                    } else {
+                        print!("{}", sum.render());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => report(&e, &sources),
+            }
+        }
+        Cmd::Dump { what: DumpCmd::Info { file } } => match crate::io::dump::info(&file) {
+            Ok(i) => {
+                print!("{}", i.render());
+                ExitCode::SUCCESS
+            }
+            Err(e) => report(&e, &SourceMap::new()),
+        },
+        Cmd::Compare { .. } | Cmd::Reference { .. } | Cmd::Convert { .. } => {
+            eprintln!("error: this subcommand is not implemented yet (see the open issues)");
+            ExitCode::from(3)
+        }
+    }
 }

@@ -5,3 +5,10 @@ pub mod domain;
 pub mod neighbor;
 pub mod kernel;
 pub mod integrate;
+pub mod fix;
+pub mod compute;
+pub mod output;
+pub mod sim;
+pub mod rng;
+
+pub use sim::{Dialect, Sim};

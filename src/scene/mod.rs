@@ -1,1 +1,349 @@
-//! scene (in progress).
+//! Commands -> a validated simulation. The [`Session`] is the interpreter's
+//! host: it executes every command that is not script-level, building the
+//! scene (units, box, regions, materials, contact model, walls, sources,
+//! outputs) and running it. In check mode (`demx check`) runs are recorded
+//! but not integrated.
+
+pub mod args;
+pub mod fixes;
+pub mod model;
+pub mod setup;
+pub mod outputs;
+pub mod summary;
+pub mod walls;
+
+use crate::engine::sim::{Dialect, Sim};
+use crate::error::{did_you_mean, Error, Result};
+use crate::script::{Command, EvalContext, Host, Span, Variables};
+use args::Args;
+use std::collections::BTreeMap;
+
+/// Unit system (`units`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Units {
+    /// SI.
+    Si,
+    /// Lennard-Jones reduced units.
+    Lj,
+    /// cgs.
+    Cgs,
+}
+
+/// One `run` of the schedule (for `demx check`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RunRecord {
+    /// Steps.
+    pub steps: i64,
+    /// Step at the start.
+    pub start: i64,
+    /// Particles when the run began.
+    pub particles: usize,
+}
+
+/// The host of the interpreter: scene under construction plus the engine.
+pub struct Session {
+    /// The simulation.
+    pub sim: Sim,
+    /// Unit system.
+    pub units: Units,
+    /// `atom_style` as written.
+    pub atom_style: Option<String>,
+    /// `fix property/global` values by name: (style, values).
+    pub props: BTreeMap<String, (String, Vec<f64>)>,
+    /// The contact model as declared.
+    pub pair: Option<model::PairSpec>,
+    /// Regions in definition order.
+    pub regions: Vec<crate::geom::Region>,
+    /// Boundary given before the box exists.
+    pub pending_sides: Option<[[crate::engine::domain::Side; 2]; 3]>,
+    /// `dimension`.
+    pub dimension: u8,
+    /// The current lattice.
+    pub lattice: Option<crate::geom::Lattice>,
+    /// Notes for commands accepted but meaningless in demx.
+    pub notes: Vec<(Span, String)>,
+    /// Runs made (or recorded, in check mode).
+    pub schedule: Vec<RunRecord>,
+    /// Whether the dialect was fixed by a command.
+    pub dialect_known: bool,
+    /// `hard_particles yes` (LIGGGHTS: moduli above 1 GPa allowed).
+    pub hard_particles: bool,
+    /// Check mode: validate, do not integrate.
+    pub check: bool,
+    /// Number of threads asked for (for notes only).
+    pub threads: usize,
+    /// Wall descriptions for the summary.
+    pub walls: Vec<String>,
+    /// Particle sources for the summary.
+    pub sources: Vec<String>,
+}
+
+/// Commands that only tune MPI, communication or memory: accepted, recorded,
+/// changing nothing in demx.
+const NOOP_COMMANDS: &[&str] = &[
+    "processors",
+    "communicate",
+    "comm_modify",
+    "comm_style",
+    "newton",
+    "partition",
+    "package",
+    "suffix",
+    "balance",
+    "atom_modify",
+    "neigh_modify_noop",
+    "sort",
+    "timer",
+    "kspace_style",
+    "special_bonds",
+    "thermo_log",
+    "modify_timing",
+];
+
+/// Commands LAMMPS/LIGGGHTS know and demx does not yet (exit 3, naming them).
+const KNOWN_UNSUPPORTED: &[&str] = &[
+    "minimize",
+    "min_style",
+    "min_modify",
+    "rerun",
+    "read_dump",
+    "write_dump",
+    "change_box",
+    "replicate",
+    "create_bonds",
+    "bond_style",
+    "bond_coeff",
+    "angle_style",
+    "angle_coeff",
+    "molecule",
+    "kspace_modify",
+    "python",
+    "shell",
+    "fix_modify",
+    "region_modify",
+    "info",
+    "clear",
+    "restart",
+    "write_coeff",
+    "pair_modify",
+    "run_style",
+    "compute_modify",
+    "reset_atom_ids",
+    "delete_bonds",
+];
+
+impl Session {
+    /// A session; `check` = validate only.
+    pub fn new(check: bool) -> Session {
+        let mut sim = Sim::default();
+        sim.dry = check;
+        Session {
+            sim,
+            units: Units::Lj,
+            atom_style: None,
+            props: BTreeMap::new(),
+            pair: None,
+            regions: vec![],
+            pending_sides: None,
+            dimension: 3,
+            lattice: None,
+            notes: vec![],
+            schedule: vec![],
+            dialect_known: false,
+            hard_particles: false,
+            check,
+            threads: 1,
+            walls: vec![],
+            sources: vec![],
+        }
+    }
+
+    /// Fix the dialect (first command that tells wins; a later contradicting
+    /// one is fine: decks mix harmless commands).
+    pub fn set_dialect(&mut self, d: Dialect) {
+        if !self.dialect_known {
+            self.sim.dialect = d;
+            self.sim.thermo.dialect = d;
+            self.dialect_known = true;
+        }
+    }
+
+    /// Group bit by name, error at `w` if unknown.
+    pub fn group(&self, w: &crate::script::Word) -> Result<u32> {
+        self.sim.group_bit(&w.text).ok_or_else(|| {
+            let mut e = Error::deck(w.span, format!("group '{}' does not exist", w.text));
+            if let Some(s) = did_you_mean(&w.text, self.sim.groups.iter().map(|s| s.as_str())) {
+                e = e.with_hint(format!("did you mean '{s}'?"));
+            }
+            e
+        })
+    }
+
+    /// The box must exist for this command.
+    pub fn need_box(&self, cmd: &Command) -> Result<()> {
+        if self.sim.domain.is_none() {
+            return Err(Error::deck(cmd.words[0].span, format!("{} command before simulation box is defined", cmd.name()))
+                .with_hint("create the box first with create_box or read_data"));
+        }
+        Ok(())
+    }
+
+    fn dispatch(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
+        let name = cmd.name();
+        match name {
+            "units" | "atom_style" | "boundary" | "dimension" | "neighbor" | "neigh_modify" | "timestep" | "hard_particles"
+            | "soft_particles" | "region" | "create_box" | "lattice" | "create_atoms" | "read_data" | "group" | "set"
+            | "velocity" | "delete_atoms" | "displace_atoms" | "reset_timestep" | "mass" | "write_data" | "write_restart"
+            | "read_restart" => setup::execute(self, cmd, vars),
+            "pair_style" | "pair_coeff" => model::execute(self, cmd),
+            "fix" | "unfix" => self.fix_command(cmd, vars),
+            "thermo" | "thermo_style" | "thermo_modify" | "dump" | "dump_modify" | "undump" | "compute" | "uncompute" => {
+                outputs::execute(self, cmd, vars)
+            }
+            "run" => self.run_command(cmd, vars),
+            n if NOOP_COMMANDS.contains(&n) => {
+                if n == "newton" {
+                    let a = Args::new(cmd);
+                    if let Some(w) = a.peek() {
+                        if !["on", "off"].contains(&w.text.as_str()) {
+                            return Err(args::bad_keyword(w, "newton setting", &["on", "off"]));
+                        }
+                    }
+                }
+                self.notes.push((cmd.span, format!("{n}: accepted; changes nothing in demx (single process, deterministic threads)")));
+                Ok(())
+            }
+            n if KNOWN_UNSUPPORTED.contains(&n) => Err(Error::unsupported(cmd.words[0].span, format!("command '{n}'"))),
+            _ => {
+                let known: Vec<&str> = ALL_COMMANDS.to_vec();
+                let mut e = Error::deck(cmd.words[0].span, format!("unknown command '{name}'"));
+                if let Some(s) = did_you_mean(name, known) {
+                    e = e.with_hint(format!("did you mean '{s}'?"));
+                }
+                Err(e)
+            }
+        }
+    }
+
+    fn fix_command(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
+        let mut a = Args::new(cmd);
+        if cmd.name() == "unfix" {
+            let w = a.word("fix id")?;
+            match self.sim.fix_index(&w.text) {
+                Some(k) => {
+                    self.sim.fixes.remove(k);
+                    Ok(())
+                }
+                None => Err(Error::deck(w.span, format!("unfix: fix '{}' does not exist", w.text))),
+            }
+        } else {
+            let id = a.word("fix id")?;
+            let gw = a.word("group")?;
+            let style = a.word("fix style")?;
+            let group = self.group(gw)?;
+            if let Some(f) = fixes::parse_simple(&self.sim, &id.text, group, &style.text, &mut a, cmd)? {
+                return self.add_fix(f);
+            }
+            model::fix_command(self, cmd, &id.text, group, style, &mut a, vars)
+        }
+    }
+
+    /// Add (or replace, same id, as LAMMPS does) a fix.
+    pub fn add_fix(&mut self, f: Box<dyn crate::engine::fix::Fix>) -> Result<()> {
+        match self.sim.fix_index(f.id()) {
+            Some(k) => self.sim.fixes[k] = f,
+            None => self.sim.fixes.push(f),
+        }
+        Ok(())
+    }
+
+    fn run_command(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
+        let mut a = Args::new(cmd);
+        let n = a.i64("number of steps")?;
+        let mut upto = false;
+        let (mut pre, mut post) = (true, true);
+        while a.more() {
+            let k = a.choice("run keyword", &["upto", "start", "stop", "pre", "post", "every"])?;
+            match k.text.as_str() {
+                "upto" => upto = true,
+                "start" | "stop" => {
+                    a.i64("step")?;
+                }
+                "pre" => pre = a.yes_no("pre")?,
+                "post" => post = a.yes_no("post")?,
+                _ => return Err(Error::deck(k.span, "run ... every is handled by the interpreter; this form is malformed")),
+            }
+        }
+        let steps = if upto { n - self.sim.step } else { n };
+        if steps < 0 {
+            return Err(Error::deck(cmd.args()[0].span, "run upto: target step is before the current step"));
+        }
+        self.need_box(cmd)?;
+        model::finalize(self, cmd)?;
+        self.schedule.push(RunRecord { steps, start: self.sim.step, particles: self.sim.particles.len() });
+        if !self.sim.fixes.iter().any(|f| f.integrates()) && !self.check {
+            self.sim.log.line("WARNING: No fixes defined, atoms won't move");
+        }
+        self.sim.run(steps, vars, pre || self.schedule.len() == 1, post)
+    }
+}
+
+/// Every command name demx knows (for did-you-mean).
+pub const ALL_COMMANDS: &[&str] = &[
+    "units", "atom_style", "atom_modify", "boundary", "dimension", "newton", "communicate", "comm_modify", "processors",
+    "neighbor", "neigh_modify", "timestep", "region", "create_box", "lattice", "create_atoms", "read_data", "group", "set",
+    "velocity", "delete_atoms", "displace_atoms", "pair_style", "pair_coeff", "fix", "unfix", "compute", "uncompute",
+    "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump", "run", "write_restart", "read_restart",
+    "write_data", "reset_timestep", "hard_particles", "soft_particles", "variable", "print", "include", "jump", "label",
+    "next", "if", "log", "echo", "quit", "mass",
+];
+
+impl EvalContext for Session {
+    fn thermo(&self, name: &str) -> Option<f64> {
+        self.sim.thermo(name)
+    }
+    fn compute(&self, id: &str, i: Option<usize>, j: Option<usize>) -> std::result::Result<f64, String> {
+        self.sim.compute(id, i, j)
+    }
+    fn fix(&self, id: &str, i: Option<usize>, j: Option<usize>) -> std::result::Result<f64, String> {
+        self.sim.fix(id, i, j)
+    }
+    fn atom_value(&self, k: &str, id: i64) -> std::result::Result<f64, String> {
+        self.sim.atom_value(k, id)
+    }
+    fn group_function(&self, name: &str, args: &[&str]) -> std::result::Result<f64, String> {
+        self.sim.group_function(name, args)
+    }
+    fn natoms(&self) -> usize {
+        self.sim.natoms()
+    }
+    fn atom_vector(&self, k: &str) -> std::result::Result<Vec<f64>, String> {
+        self.sim.atom_vector(k)
+    }
+    fn peratom(&self, p: char, id: &str, col: Option<usize>) -> std::result::Result<Vec<f64>, String> {
+        self.sim.peratom(p, id, col)
+    }
+}
+
+impl Host for Session {
+    fn execute(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
+        self.dispatch(cmd, vars)
+    }
+    fn output(&mut self, text: &str) {
+        self.sim.log.line(text);
+    }
+    fn set_log(&mut self, path: Option<&str>, append: bool, span: Span) -> Result<()> {
+        match path {
+            None => {
+                self.sim.log.file = None;
+                Ok(())
+            }
+            Some(p) => {
+                if self.check {
+                    return Ok(());
+                }
+                self.sim.log.open(p, append).map_err(|e| Error::io(span, format!("cannot open log file '{p}'"), &e))
+            }
+        }
+    }
+}

@@ -1,0 +1,247 @@
+//! Computes (`compute ID group style ...`) and per-atom properties.
+
+use super::sim::Sim;
+
+/// What a compute computes.
+#[derive(Clone, Debug, serde::Serialize)]
+pub enum ComputeKind {
+    /// `ke`: translational kinetic energy of the group.
+    Ke,
+    /// `erotate/sphere`: rotational kinetic energy.
+    ErotateSphere,
+    /// `temp`: temperature (translational, dof 3N-3).
+    Temp,
+    /// `reduce MODE value ...` (`sum`, `min`, `max`, `ave`, `sumsq`, `avesq`).
+    Reduce {
+        /// Reduction mode.
+        mode: String,
+        /// Inputs: `x`, `vx`, `c_ID`, `c_ID[i]`, `v_name`, `f_ID[i]`.
+        inputs: Vec<String>,
+    },
+    /// `property/atom name ...`: per-atom columns.
+    PropertyAtom {
+        /// Column names.
+        names: Vec<String>,
+    },
+    /// `com`: centre of mass (vector of 3).
+    Com,
+    /// A style demx records (for `demx check`) but cannot evaluate.
+    Other(String),
+}
+
+/// A defined compute.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Compute {
+    /// Id.
+    pub id: String,
+    /// Group bit.
+    pub group: u32,
+    /// Style.
+    pub kind: ComputeKind,
+    /// Style name as written.
+    pub style: String,
+}
+
+impl Compute {
+    /// Global scalar (`i` None) or vector element.
+    pub fn global(&self, sim: &Sim, i: Option<usize>) -> Result<f64, String> {
+        match (&self.kind, i) {
+            (ComputeKind::Ke, None) => Ok(sim.kinetic_energy(self.group)),
+            (ComputeKind::ErotateSphere, None) => Ok(sim.rotational_energy(self.group)),
+            (ComputeKind::Temp, None) => Ok(sim.temperature()),
+            (ComputeKind::Com, Some(k @ 1..=3)) => {
+                let p = &sim.particles;
+                let (mut m, mut s) = (0.0, 0.0);
+                for j in 0..p.len() {
+                    if p.mask[j] & self.group != 0 {
+                        m += p.mass[j];
+                        s += p.mass[j] * unwrapped(sim, j)[k - 1];
+                    }
+                }
+                Ok(if m > 0.0 { s / m } else { 0.0 })
+            }
+            (ComputeKind::Reduce { mode, inputs }, idx) => {
+                let k = idx.unwrap_or(1);
+                if idx.is_none() && inputs.len() != 1 {
+                    return Err(format!("compute {} reduces {} values: use c_{}[i]", self.id, inputs.len(), self.id));
+                }
+                let input = inputs.get(k - 1).ok_or_else(|| format!("compute {} has no value {k}", self.id))?;
+                let vals = self.input_values(sim, input)?;
+                let p = &sim.particles;
+                let sel: Vec<f64> = vals.iter().enumerate().filter(|(j, _)| p.mask[*j] & self.group != 0).map(|(_, &v)| v).collect();
+                let n = sel.len() as f64;
+                Ok(match mode.as_str() {
+                    "sum" => sel.iter().sum(),
+                    "sumsq" => sel.iter().map(|v| v * v).sum(),
+                    "ave" => {
+                        if n > 0.0 {
+                            sel.iter().sum::<f64>() / n
+                        } else {
+                            0.0
+                        }
+                    }
+                    "avesq" => {
+                        if n > 0.0 {
+                            sel.iter().map(|v| v * v).sum::<f64>() / n
+                        } else {
+                            0.0
+                        }
+                    }
+                    "min" => sel.iter().cloned().fold(f64::INFINITY, f64::min),
+                    "max" => sel.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+                    "sumabs" => sel.iter().map(|v| v.abs()).sum(),
+                    "aveabs" => {
+                        if n > 0.0 {
+                            sel.iter().map(|v| v.abs()).sum::<f64>() / n
+                        } else {
+                            0.0
+                        }
+                    }
+                    m => return Err(format!("unknown reduce mode {m}")),
+                })
+            }
+            _ => Err(format!("compute {} ({}) has no such global value", self.id, self.style)),
+        }
+    }
+
+    fn input_values(&self, sim: &Sim, input: &str) -> Result<Vec<f64>, String> {
+        use crate::script::EvalContext;
+        if let Some(rest) = input.strip_prefix("c_") {
+            let (id, col) = split_index(rest);
+            return sim.peratom('c', id, col);
+        }
+        if let Some(rest) = input.strip_prefix("v_") {
+            return Err(format!("atom-style variable v_{rest} in compute reduce must be evaluated by the caller"));
+        }
+        sim.atom_vector(input)
+    }
+
+    /// Per-atom values (property/atom column `col`, 1-based; None = the only one).
+    pub fn peratom(&self, sim: &Sim, col: Option<usize>) -> Result<Vec<f64>, String> {
+        match &self.kind {
+            ComputeKind::PropertyAtom { names } => {
+                let k = col.unwrap_or(1);
+                let name = names.get(k - 1).ok_or_else(|| format!("compute {} has no column {k}", self.id))?;
+                (0..sim.particles.len()).map(|i| atom_property(sim, name, i).ok_or_else(|| format!("unknown property {name}"))).collect()
+            }
+            _ => Err(format!("compute {} ({}) has no per-atom values", self.id, self.style)),
+        }
+    }
+}
+
+fn split_index(s: &str) -> (&str, Option<usize>) {
+    if let Some(b) = s.find('[') {
+        let idx = s[b + 1..].trim_end_matches(']').parse().ok();
+        (&s[..b], idx)
+    } else {
+        (s, None)
+    }
+}
+
+/// Unwrapped position of particle i (x + image * L).
+pub fn unwrapped(sim: &Sim, i: usize) -> crate::physics::V3 {
+    let p = &sim.particles;
+    let mut x = p.x[i];
+    if let Some(d) = &sim.domain {
+        for k in 0..3 {
+            x[k] += p.image[i][k] as f64 * d.len(k);
+        }
+    }
+    x
+}
+
+/// A per-atom property by LAMMPS name (dump custom / atom variables).
+pub fn atom_property(sim: &Sim, name: &str, i: usize) -> Option<f64> {
+    let p = &sim.particles;
+    Some(match name {
+        "id" => p.tag[i] as f64,
+        "type" => p.kind[i] as f64,
+        "mass" => p.mass[i],
+        "radius" => p.radius[i],
+        "diameter" => 2.0 * p.radius[i],
+        "density" => p.density[i],
+        "x" => p.x[i].x,
+        "y" => p.x[i].y,
+        "z" => p.x[i].z,
+        "xu" => unwrapped(sim, i).x,
+        "yu" => unwrapped(sim, i).y,
+        "zu" => unwrapped(sim, i).z,
+        "ix" => p.image[i][0] as f64,
+        "iy" => p.image[i][1] as f64,
+        "iz" => p.image[i][2] as f64,
+        "vx" => p.v[i].x,
+        "vy" => p.v[i].y,
+        "vz" => p.v[i].z,
+        "fx" => p.f[i].x,
+        "fy" => p.f[i].y,
+        "fz" => p.f[i].z,
+        "omegax" | "wx" => p.omega[i].x,
+        "omegay" | "wy" => p.omega[i].y,
+        "omegaz" | "wz" => p.omega[i].z,
+        "tqx" => p.torque[i].x,
+        "tqy" => p.torque[i].y,
+        "tqz" => p.torque[i].z,
+        "angmomx" => p.inertia(i) * p.omega[i].x,
+        "angmomy" => p.inertia(i) * p.omega[i].y,
+        "angmomz" => p.inertia(i) * p.omega[i].z,
+        "mol" => 0.0,
+        "q" => 0.0,
+        "xs" | "ys" | "zs" => {
+            let d = sim.domain.as_ref()?;
+            let k = (name.as_bytes()[0] - b'x') as usize;
+            (p.x[i][k] - d.lo[k]) / d.len(k)
+        }
+        _ => return None,
+    })
+}
+
+/// Group functions of the variable language: count, mass, xcm, vcm, ke, bound.
+pub fn group_function(sim: &Sim, name: &str, args: &[&str]) -> Result<f64, String> {
+    let g = args.first().ok_or_else(|| format!("{name}() needs a group"))?;
+    let bit = sim.group_bit(g).ok_or_else(|| format!("group {g} does not exist"))?;
+    let p = &sim.particles;
+    let members = || (0..p.len()).filter(move |&i| p.mask[i] & bit != 0);
+    let dim = |s: Option<&&str>| -> Result<usize, String> {
+        match s.copied() {
+            Some("x") => Ok(0),
+            Some("y") => Ok(1),
+            Some("z") => Ok(2),
+            other => Err(format!("{name}() needs a dimension x, y or z, not {other:?}")),
+        }
+    };
+    Ok(match name {
+        "count" => members().count() as f64,
+        "mass" => members().map(|i| p.mass[i]).sum(),
+        "ke" => sim.kinetic_energy(bit),
+        "xcm" | "vcm" | "fcm" => {
+            let k = dim(args.get(1))?;
+            let m: f64 = members().map(|i| p.mass[i]).sum();
+            if name == "fcm" {
+                return Ok(members().map(|i| p.f[i][k]).sum());
+            }
+            if m == 0.0 {
+                return Ok(0.0);
+            }
+            let s: f64 = members()
+                .map(|i| p.mass[i] * if name == "xcm" { unwrapped(sim, i)[k] } else { p.v[i][k] })
+                .sum();
+            s / m
+        }
+        "bound" => {
+            let which = args.get(1).ok_or("bound() needs xmin/xmax/...")?;
+            let k = match &which[..1] {
+                "x" => 0,
+                "y" => 1,
+                "z" => 2,
+                _ => return Err(format!("bad bound {which}")),
+            };
+            let it = members().map(|i| p.x[i][k]);
+            if which.ends_with("min") {
+                it.fold(f64::INFINITY, f64::min)
+            } else {
+                it.fold(f64::NEG_INFINITY, f64::max)
+            }
+        }
+        _ => return Err(format!("unknown group function {name}()")),
+    })
+}

@@ -1,0 +1,352 @@
+//! Screen/log output, thermo lines in each engine's format, and the dump
+//! interface.
+
+use super::sim::{Dialect, Sim};
+use crate::error::{Error, Result};
+use crate::io::cfmt::{sprintf, CArg};
+use crate::script::Variables;
+use std::fs::File;
+use std::io::{IsTerminal, Write};
+
+/// Screen and log file.
+pub struct Logger {
+    /// Print to stdout.
+    pub screen: bool,
+    /// The log file, flushed after every line.
+    pub file: Option<File>,
+    /// Whether a progress line is currently shown on the terminal.
+    progress_shown: bool,
+    /// Whether stderr is a terminal (progress lines only then).
+    pub tty: bool,
+    /// Everything printed, kept when `capture` is on (tests, check).
+    pub captured: Option<String>,
+}
+
+impl Default for Logger {
+    fn default() -> Self {
+        Logger { screen: true, file: None, progress_shown: false, tty: std::io::stderr().is_terminal(), captured: None }
+    }
+}
+
+impl Logger {
+    /// Print a line (or several) to screen and log.
+    pub fn line(&mut self, text: &str) {
+        self.clear_progress();
+        let text = text.strip_suffix('\n').unwrap_or(text);
+        if self.screen {
+            let mut out = std::io::stdout().lock();
+            let _ = writeln!(out, "{text}");
+        }
+        if let Some(f) = &mut self.file {
+            let _ = writeln!(f, "{text}");
+            let _ = f.flush();
+        }
+        if let Some(c) = &mut self.captured {
+            c.push_str(text);
+            c.push('\n');
+        }
+    }
+    /// Show a progress line on the terminal only (never in logs or pipes).
+    pub fn progress(&mut self, text: &str) {
+        if self.tty && self.screen {
+            let _ = write!(std::io::stderr(), "\r\x1b[2K{text}");
+            self.progress_shown = true;
+        }
+    }
+    /// Remove the progress line.
+    pub fn clear_progress(&mut self) {
+        if self.progress_shown {
+            let _ = write!(std::io::stderr(), "\r\x1b[2K");
+            self.progress_shown = false;
+        }
+    }
+    /// Open (or append to) a log file.
+    pub fn open(&mut self, path: &str, append: bool) -> std::io::Result<()> {
+        let f = if append { std::fs::OpenOptions::new().create(true).append(true).open(path)? } else { File::create(path)? };
+        self.file = Some(f);
+        Ok(())
+    }
+}
+
+/// What to do with particles lost through fixed boundaries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum LostPolicy {
+    /// Stop the run (LAMMPS default).
+    Error,
+    /// Warn once and delete them.
+    Warn,
+    /// Delete them silently.
+    Ignore,
+}
+
+/// Thermo settings (`thermo`, `thermo_style`, `thermo_modify`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Thermo {
+    /// Print every N steps (0: only first and last step of a run).
+    pub every: i64,
+    /// Keywords.
+    pub keywords: Vec<String>,
+    /// Lost-atom policy.
+    pub lost: LostPolicy,
+    /// Normalise extensive quantities by atom count.
+    pub norm: bool,
+    /// Format of the whole line (`thermo_modify format line`).
+    pub format_line: Option<String>,
+    /// Per-column formats (`thermo_modify format N fmt`), by 1-based column.
+    pub format_col: Vec<(usize, String)>,
+    /// `thermo_modify format float`.
+    pub format_float: Option<String>,
+    /// `thermo_modify format int`.
+    pub format_int: Option<String>,
+    /// Which engine's layout to copy.
+    pub dialect: Dialect,
+}
+
+impl Default for Thermo {
+    fn default() -> Self {
+        Thermo {
+            every: 0,
+            keywords: ["step", "temp", "epair", "emol", "etotal", "press"].iter().map(|s| s.to_string()).collect(),
+            lost: LostPolicy::Error,
+            norm: false,
+            format_line: None,
+            format_col: vec![],
+            format_float: None,
+            format_int: None,
+            dialect: Dialect::Lammps,
+        }
+    }
+}
+
+fn header_name(k: &str) -> String {
+    match k {
+        "step" => "Step".into(),
+        "elapsed" => "Elapsed".into(),
+        "elaplong" => "Elaplong".into(),
+        "dt" => "Dt".into(),
+        "time" => "Time".into(),
+        "cpu" => "CPU".into(),
+        "atoms" => "Atoms".into(),
+        "temp" => "Temp".into(),
+        "press" => "Press".into(),
+        "pe" => "PotEng".into(),
+        "ke" => "KinEng".into(),
+        "etotal" => "TotEng".into(),
+        "epair" => "E_pair".into(),
+        "emol" => "E_mol".into(),
+        "vol" => "Volume".into(),
+        "lx" => "Lx".into(),
+        "ly" => "Ly".into(),
+        "lz" => "Lz".into(),
+        "xlo" => "Xlo".into(),
+        "xhi" => "Xhi".into(),
+        "ylo" => "Ylo".into(),
+        "yhi" => "Yhi".into(),
+        "zlo" => "Zlo".into(),
+        "zhi" => "Zhi".into(),
+        "spcpu" => "S/CPU".into(),
+        "cpuremain" => "CPULeft".into(),
+        "density" => "Density".into(),
+        other => other.to_string(),
+    }
+}
+
+fn is_int_keyword(k: &str) -> bool {
+    matches!(k, "step" | "elapsed" | "elaplong" | "atoms" | "nbuild" | "ndanger")
+}
+
+impl Thermo {
+    /// The header line.
+    pub fn header(&self, _sim: &Sim) -> String {
+        let mut s = String::new();
+        for k in &self.keywords {
+            let name = match self.dialect {
+                // LIGGGHTS prints c_ID / f_ID / v_ID headers without the prefix
+                Dialect::Liggghts => {
+                    let h = header_name(k);
+                    h.strip_prefix("c_").or_else(|| h.strip_prefix("f_")).or_else(|| h.strip_prefix("v_")).map(str::to_string).unwrap_or(h)
+                }
+                Dialect::Lammps => header_name(k),
+            };
+            match self.dialect {
+                Dialect::Lammps => {
+                    s.push_str(&name);
+                    s.push(' ');
+                }
+                Dialect::Liggghts => {
+                    let w = if is_int_keyword(k) { 8 } else { 14 };
+                    s.push_str(&format!("{name:>w$} "));
+                }
+            }
+        }
+        s
+    }
+
+    /// One thermo line at the current step.
+    pub fn line(&self, sim: &Sim, vars: &Variables) -> Result<String> {
+        let mut vals: Vec<(bool, f64)> = Vec::with_capacity(self.keywords.len());
+        for k in &self.keywords {
+            let v = thermo_value(sim, vars, k)?;
+            vals.push((is_int_keyword(k), v));
+        }
+        if let Some(fl) = &self.format_line {
+            let args: Vec<CArg> = vals.iter().map(|&(int, v)| if int { CArg::Int(v as i64) } else { CArg::Float(v) }).collect();
+            return sprintf(fl, &args).map_err(|e| Error::runtime(format!("thermo_modify format line: {e}")));
+        }
+        let mut s = String::new();
+        for (col, &(int, v)) in vals.iter().enumerate() {
+            let custom = self.format_col.iter().find(|(c, _)| *c == col + 1).map(|(_, f)| f.clone());
+            let fmt = custom.or_else(|| if int { self.format_int.clone() } else { self.format_float.clone() });
+            let text = match fmt {
+                Some(f) => sprintf(&f, &[if int { CArg::Int(v as i64) } else { CArg::Float(v) }]).unwrap_or_else(|_| v.to_string()),
+                None => match (self.dialect, int) {
+                    (Dialect::Lammps, true) => format!("{:>8}", v as i64),
+                    (Dialect::Lammps, false) => format!("{:>12}", crate::io::cfmt::fmt_g(v, 8)),
+                    (Dialect::Liggghts, true) => format!("{:>8}", v as i64),
+                    (Dialect::Liggghts, false) => format!("{:>14}", crate::io::cfmt::fmt_g(v, 8)),
+                },
+            };
+            s.push_str(&text);
+            s.push(' ');
+        }
+        Ok(s)
+    }
+}
+
+/// Value of one thermo column: keyword, c_ID[i], f_ID[i], v_name.
+pub fn thermo_value(sim: &Sim, vars: &Variables, k: &str) -> Result<f64> {
+    use crate::script::EvalContext;
+    let err = |e: String| Error::runtime(format!("thermo keyword {k}: {e}"));
+    if let Some(rest) = k.strip_prefix("c_") {
+        let (id, i) = split_bracket(rest);
+        return sim.compute(id, i, None).map_err(err);
+    }
+    if let Some(rest) = k.strip_prefix("f_") {
+        let (id, i) = split_bracket(rest);
+        return sim.fix(id, i, None).map_err(err);
+    }
+    if let Some(rest) = k.strip_prefix("v_") {
+        return vars.eval_equal(rest, sim).map_err(err);
+    }
+    thermo_keyword(sim, k).ok_or_else(|| Error::runtime(format!("unknown thermo keyword {k}")))
+}
+
+fn split_bracket(s: &str) -> (&str, Option<usize>) {
+    match s.find('[') {
+        Some(b) => (&s[..b], s[b + 1..].trim_end_matches(']').parse().ok()),
+        None => (s, None),
+    }
+}
+
+/// Built-in thermo keywords.
+pub fn thermo_keyword(sim: &Sim, k: &str) -> Option<f64> {
+    let n = sim.particles.len() as f64;
+    let norm = |v: f64| if sim.thermo.norm && n > 0.0 { v / n } else { v };
+    let d = sim.domain.as_ref();
+    Some(match k {
+        "step" => sim.step as f64,
+        "elapsed" => (sim.step - sim.run_start) as f64,
+        "elaplong" => (sim.step - sim.run_start) as f64,
+        "dt" => sim.dt,
+        "time" => sim.time,
+        "cpu" => sim.clock.elapsed().as_secs_f64(),
+        "atoms" => n,
+        "temp" => sim.temperature(),
+        "ke" => {
+            // LAMMPS: ke from the temperature (0 when dof <= 0)
+            let dim = d.map_or(3.0, |d| d.dimension as f64);
+            let dof = dim * n - dim;
+            norm(if dof > 0.0 { 0.5 * dof * sim.boltz * sim.temperature() } else { 0.0 })
+        }
+        "pe" | "epair" | "emol" | "evdwl" | "ecoul" | "ebond" | "elong" => 0.0,
+        "etotal" => {
+            let dim = d.map_or(3.0, |d| d.dimension as f64);
+            let dof = dim * n - dim;
+            norm(if dof > 0.0 { 0.5 * dof * sim.boltz * sim.temperature() } else { 0.0 })
+        }
+        "press" => {
+            let v = d.map_or(0.0, |d| d.volume());
+            if v == 0.0 {
+                0.0
+            } else {
+                let dim = d.map_or(3.0, |d| d.dimension as f64);
+                let dof = dim * n - dim;
+                (dof.max(0.0) * sim.boltz * sim.temperature() + sim.virial()) / (dim * v)
+            }
+        }
+        "vol" => d.map_or(0.0, |d| d.volume()),
+        "lx" => d.map_or(0.0, |d| d.len(0)),
+        "ly" => d.map_or(0.0, |d| d.len(1)),
+        "lz" => d.map_or(0.0, |d| d.len(2)),
+        "xlo" => d.map_or(0.0, |d| d.lo[0]),
+        "xhi" => d.map_or(0.0, |d| d.hi[0]),
+        "ylo" => d.map_or(0.0, |d| d.lo[1]),
+        "yhi" => d.map_or(0.0, |d| d.hi[1]),
+        "zlo" => d.map_or(0.0, |d| d.lo[2]),
+        "zhi" => d.map_or(0.0, |d| d.hi[2]),
+        "density" => {
+            let v = d.map_or(0.0, |d| d.volume());
+            if v > 0.0 {
+                sim.particles.mass.iter().sum::<f64>() / v
+            } else {
+                0.0
+            }
+        }
+        "nbuild" => sim.pairs.builds as f64,
+        "ndanger" => sim.pairs.dangerous as f64,
+        "spcpu" => sim.last_rate,
+        "cpuremain" => 0.0,
+        "maxoverlap" => max_overlap(sim),
+        _ => return None,
+    })
+}
+
+/// Largest relative overlap delta / min(ri, rj) over current pairs (demx's
+/// `maxoverlap` thermo keyword).
+pub fn max_overlap(sim: &Sim) -> f64 {
+    let p = &sim.particles;
+    let mut m: f64 = 0.0;
+    for k in 0..sim.pairs.len() {
+        let (a, b) = (sim.pairs.a[k] as usize, sim.pairs.b[k] as usize);
+        if a >= p.len() || b >= p.len() {
+            continue;
+        }
+        let r = (p.x[a] - p.x[b] - sim.pairs.shift[k]).norm();
+        let delta = p.radius[a] + p.radius[b] - r;
+        m = m.max(delta / p.radius[a].min(p.radius[b]));
+    }
+    m
+}
+
+/// A dump (`dump ID group style N file ...`).
+pub trait Dump: Send {
+    /// Whether a frame is due at `step` (`first`: the start of a run).
+    fn due(&self, step: i64, first: bool) -> bool;
+    /// Write one frame (flushed).
+    fn write(&mut self, sim: &Sim) -> Result<()>;
+    /// The dump id.
+    fn id(&self) -> &str;
+    /// `dump_modify` options.
+    fn modify(&mut self, _args: &[crate::script::Word]) -> Result<()> {
+        Ok(())
+    }
+    /// One line for `demx check`.
+    fn summary(&self) -> String;
+}
+
+/// Placeholder while a dump writes.
+pub struct NoDump;
+impl Dump for NoDump {
+    fn due(&self, _: i64, _: bool) -> bool {
+        false
+    }
+    fn write(&mut self, _: &Sim) -> Result<()> {
+        Ok(())
+    }
+    fn id(&self) -> &str {
+        ""
+    }
+    fn summary(&self) -> String {
+        String::new()
+    }
+}

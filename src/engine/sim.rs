@@ -1,0 +1,399 @@
+//! The simulation state and the run loop (LAMMPS `Verlet::run` order).
+
+use super::compute::Compute;
+use super::domain::Domain;
+use super::fix::{Fix, Hole};
+use super::kernel::{gather, ContactKernel, PairOut, ParamTable};
+use super::neighbor::{NeighSettings, PairList};
+use super::output::{Dump, Logger, Thermo};
+use super::particles::Particles;
+use crate::error::{Error, Result};
+use crate::physics::V3;
+use crate::script::{EvalContext, Variables};
+use std::time::Instant;
+
+/// Which engine's conventions a deck follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Dialect {
+    /// LIGGGHTS 3.x (`pair_style gran model ...`).
+    Liggghts,
+    /// LAMMPS (`pair_style granular`, `gran/hooke/history`, ...).
+    Lammps,
+}
+
+/// The contact model of the scene, ready to run.
+pub struct PairModel {
+    /// The monomorphised kernel.
+    pub kernel: Box<dyn ContactKernel>,
+    /// Coefficients per type pair.
+    pub table: ParamTable,
+    /// Human summary, e.g. `hertz + tangential history`.
+    pub summary: String,
+}
+
+/// Everything a run needs.
+pub struct Sim {
+    /// Deck dialect.
+    pub dialect: Dialect,
+    /// The box (None before create_box / read_data).
+    pub domain: Option<Domain>,
+    /// Number of atom types.
+    pub ntypes: usize,
+    /// The particles.
+    pub particles: Particles,
+    /// Group names; index = bit.
+    pub groups: Vec<String>,
+    /// Neighbour settings.
+    pub neigh: NeighSettings,
+    /// Pair list with history.
+    pub pairs: PairList,
+    /// Pair outputs of the last force evaluation (virial, per-contact output).
+    pub pair_out: Vec<PairOut>,
+    /// The contact model (None: no pair interactions).
+    pub model: Option<PairModel>,
+    /// Fixes in definition order.
+    pub fixes: Vec<Box<dyn Fix>>,
+    /// Computes.
+    pub computes: Vec<Compute>,
+    /// Thermo settings.
+    pub thermo: Thermo,
+    /// Dumps.
+    pub dumps: Vec<Box<dyn Dump>>,
+    /// Screen and log output.
+    pub log: Logger,
+    /// Current step.
+    pub step: i64,
+    /// Step at the start of the current run (`elapsed`).
+    pub run_start: i64,
+    /// Last step of the current run.
+    pub run_end: i64,
+    /// Time step size.
+    pub dt: f64,
+    /// Simulated time.
+    pub time: f64,
+    /// Particles lost through fixed boundaries so far.
+    pub lost: u64,
+    /// A rebuild is wanted at the next step (particles added/removed).
+    pub force_rebuild: bool,
+    /// Wall-clock start of the current run.
+    pub clock: Instant,
+    /// Whether to actually integrate (false for `demx check`).
+    pub dry: bool,
+    /// Boltzmann constant of the unit system.
+    pub boltz: f64,
+    /// Steps per second of the last run.
+    pub last_rate: f64,
+    /// Time spent per section of the last run: pair, neigh, modify, output.
+    pub timing: [f64; 4],
+}
+
+impl Default for Sim {
+    fn default() -> Self {
+        Sim {
+            dialect: Dialect::Lammps,
+            domain: None,
+            ntypes: 0,
+            particles: Particles::default(),
+            groups: vec!["all".into()],
+            neigh: NeighSettings::default(),
+            pairs: PairList::default(),
+            pair_out: vec![],
+            model: None,
+            fixes: vec![],
+            computes: vec![],
+            thermo: Thermo::default(),
+            dumps: vec![],
+            log: Logger::default(),
+            step: 0,
+            run_start: 0,
+            run_end: 0,
+            dt: 1e-5,
+            time: 0.0,
+            lost: 0,
+            force_rebuild: true,
+            clock: Instant::now(),
+            dry: false,
+            boltz: 1.380649e-23,
+            last_rate: 0.0,
+            timing: [0.0; 4],
+        }
+    }
+}
+
+impl Sim {
+    /// Bit of a group by name.
+    pub fn group_bit(&self, name: &str) -> Option<u32> {
+        self.groups.iter().position(|g| g == name).map(|k| 1u32 << k)
+    }
+
+    /// Run `hook` on every fix in order, each taken out of the list while it runs.
+    pub fn each_fix(&mut self, mut hook: impl FnMut(&mut dyn Fix, &mut Sim) -> Result<()>) -> Result<()> {
+        for k in 0..self.fixes.len() {
+            let mut f = std::mem::replace(&mut self.fixes[k], Box::new(Hole));
+            let r = hook(f.as_mut(), self);
+            self.fixes[k] = f;
+            r?;
+        }
+        Ok(())
+    }
+
+    /// Index of a fix by id.
+    pub fn fix_index(&self, id: &str) -> Option<usize> {
+        self.fixes.iter().position(|f| f.id() == id)
+    }
+
+    /// Wrap, drop lost particles, shrink-wrap and rebuild the pair list.
+    pub fn rebuild(&mut self) -> Result<()> {
+        let Some(dom) = self.domain.as_mut() else { return Ok(()) };
+        let p = &mut self.particles;
+        for i in 0..p.len() {
+            dom.wrap(&mut p.x[i], &mut p.image[i]);
+        }
+        let lost: Vec<bool> = p.x.iter().map(|x| dom.outside_fixed(x) || !x.iter().all(|c| c.is_finite())).collect();
+        let nlost = lost.iter().filter(|&&l| l).count();
+        if nlost > 0 {
+            match self.thermo.lost {
+                super::output::LostPolicy::Error => {
+                    let i = lost.iter().position(|&l| l).unwrap_or(0);
+                    return Err(Error::runtime(format!(
+                        "Lost atoms: original {} current {} at step {} (atom {} at {:?}); use `thermo_modify lost ignore` to delete them",
+                        p.len(),
+                        p.len() - nlost,
+                        self.step,
+                        p.tag[i],
+                        [p.x[i].x, p.x[i].y, p.x[i].z]
+                    )));
+                }
+                _ => {
+                    p.remove_where(&lost);
+                    self.lost += nlost as u64;
+                }
+            }
+        }
+        dom.shrink_wrap(&p.x);
+        let width = self.model.as_ref().map_or(0, |m| m.kernel.history_width());
+        let table = self.model.as_ref().map(|m| &m.table);
+        let p = &self.particles;
+        let dom = self.domain.as_ref().ok_or_else(|| Error::runtime("no box"))?;
+        match table {
+            Some(t) if t.max_extra_range() > 0.0 => {
+                let kinds = &p.kind;
+                self.pairs.build(p, dom, &self.neigh, self.step, width, |i, j| t.get(kinds[i], kinds[j]).extra_range)
+            }
+            Some(_) => self.pairs.build(p, dom, &self.neigh, self.step, width, |_, _| 0.0),
+            None => {
+                // no pair style: no pairs, but keep the skin bookkeeping
+                self.pairs = PairList { x_built: p.x.clone(), last_build: self.step, ..Default::default() };
+                self.pairs.adj_start = vec![0; p.len() + 1];
+            }
+        }
+        self.force_rebuild = false;
+        Ok(())
+    }
+
+    /// Clear forces and compute pair forces.
+    pub fn pair_forces(&mut self) {
+        let p = &mut self.particles;
+        for f in p.f.iter_mut() {
+            *f = V3::zeros();
+        }
+        for t in p.torque.iter_mut() {
+            *t = V3::zeros();
+        }
+        if let Some(m) = &self.model {
+            m.kernel.pair_pass(&self.particles, &mut self.pairs, &m.table, self.dt, &mut self.pair_out);
+            let p = &mut self.particles;
+            gather(&self.pairs, &self.pair_out, &mut p.f, &mut p.torque);
+        }
+    }
+
+    /// Forces at the start of a run (LAMMPS `Verlet::setup`).
+    pub fn setup(&mut self, vars: &Variables) -> Result<()> {
+        self.each_fix(|f, s| f.setup(s))?;
+        self.rebuild()?;
+        self.pair_forces();
+        self.each_fix(|f, s| f.post_force(s, vars))?;
+        Ok(())
+    }
+
+    /// Run `n` steps. Thermo and dumps are written at step 0 of the run, every
+    /// N steps, and at the last step, as LAMMPS does.
+    pub fn run(&mut self, n: i64, vars: &Variables, pre: bool, post: bool) -> Result<()> {
+        self.run_start = self.step;
+        self.run_end = self.step + n;
+        self.clock = Instant::now();
+        self.timing = [0.0; 4];
+        if pre || self.pairs.x_built.len() != self.particles.len() {
+            self.setup(vars)?;
+        }
+        self.output(vars, true)?;
+        if self.dry {
+            self.step += n;
+            self.time += n as f64 * self.dt;
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        for _ in 0..n {
+            self.one_step(vars)?;
+        }
+        let secs = t0.elapsed().as_secs_f64();
+        self.last_rate = if secs > 0.0 { n as f64 / secs } else { 0.0 };
+        if post {
+            self.log.line(&self.run_summary(n, secs));
+        }
+        Ok(())
+    }
+
+    fn one_step(&mut self, vars: &Variables) -> Result<()> {
+        self.step += 1;
+        self.time += self.dt;
+        let t = Instant::now();
+        self.each_fix(|f, s| {
+            f.initial_integrate(s);
+            Ok(())
+        })?;
+        let step = self.step;
+        let wanted = self.fixes.iter().any(|f| f.next_reneighbor() == Some(step));
+        let tm = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        if self.force_rebuild || wanted || self.pairs.needs_rebuild(&self.particles, &self.neigh, self.step) {
+            self.each_fix(|f, s| f.pre_exchange(s, vars))?;
+            self.rebuild()?;
+        }
+        let tn = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        self.pair_forces();
+        let tp = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        self.each_fix(|f, s| f.post_force(s, vars))?;
+        self.each_fix(|f, s| {
+            f.final_integrate(s);
+            Ok(())
+        })?;
+        self.each_fix(|f, s| f.end_of_step(s, vars))?;
+        let tm2 = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        self.output(vars, false)?;
+        self.timing[0] += tp;
+        self.timing[1] += tn;
+        self.timing[2] += tm + tm2;
+        self.timing[3] += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Thermo and dumps due at this step.
+    fn output(&mut self, vars: &Variables, first: bool) -> Result<()> {
+        let last = self.step == self.run_end;
+        let every = self.thermo.every;
+        if first || last || (every > 0 && self.step % every == 0) {
+            if first {
+                let h = self.thermo.header(self);
+                self.log.line(&h);
+            }
+            let line = self.thermo.line(self, vars)?;
+            self.log.line(&line);
+        }
+        for k in 0..self.dumps.len() {
+            let due = self.dumps[k].due(self.step, first);
+            if due {
+                let mut d = std::mem::replace(&mut self.dumps[k], Box::new(super::output::NoDump));
+                let r = d.write(self);
+                self.dumps[k] = d;
+                r?;
+            }
+        }
+        Ok(())
+    }
+
+    fn run_summary(&self, n: i64, secs: f64) -> String {
+        let np = self.particles.len();
+        let mut s = format!("Loop time of {} on 1 procs for {} steps with {} atoms\n", crate::io::cfmt::fmt_g(secs, 6), n, np);
+        let total = secs.max(1e-300);
+        let names = ["Pair", "Neigh", "Modify", "Output"];
+        s.push_str("\nSection |  time (s)  | %total\n");
+        for (k, name) in names.iter().enumerate() {
+            s.push_str(&format!("{:<7} | {:<10.4e} | {:6.2}\n", name, self.timing[k], 100.0 * self.timing[k] / total));
+        }
+        let ps = if secs > 0.0 { np as f64 * n as f64 / secs } else { 0.0 };
+        s.push_str(&format!("\nPerformance: {:.4e} particle-steps/s, {:.1} steps/s\n", ps, if secs > 0.0 { n as f64 / secs } else { 0.0 }));
+        s.push_str(&format!("Neighbor list builds = {}\nDangerous builds = {}\n", self.pairs.builds, self.pairs.dangerous));
+        s
+    }
+
+    /// Kinetic energy (translational) of a group.
+    pub fn kinetic_energy(&self, bit: u32) -> f64 {
+        let p = &self.particles;
+        (0..p.len()).filter(|&i| p.mask[i] & bit != 0).map(|i| 0.5 * p.mass[i] * p.v[i].norm_squared()).sum()
+    }
+
+    /// Rotational kinetic energy of a group.
+    pub fn rotational_energy(&self, bit: u32) -> f64 {
+        let p = &self.particles;
+        (0..p.len()).filter(|&i| p.mask[i] & bit != 0).map(|i| 0.5 * p.inertia(i) * p.omega[i].norm_squared()).sum()
+    }
+
+    /// Temperature as LAMMPS `compute temp` (dof = 3N - 3, or 2N - 2 in 2d).
+    pub fn temperature(&self) -> f64 {
+        let n = self.particles.len() as f64;
+        let dim = self.domain.as_ref().map_or(3, |d| d.dimension) as f64;
+        let dof = dim * n - dim;
+        if dof <= 0.0 {
+            return 0.0;
+        }
+        let mv2: f64 = (0..self.particles.len()).map(|i| self.particles.mass[i] * self.particles.v[i].norm_squared()).sum();
+        mv2 / (dof * self.boltz)
+    }
+
+    /// Pair virial trace sum r_ij . F_ij of the last force evaluation.
+    pub fn virial(&self) -> f64 {
+        let p = &self.particles;
+        let mut w = 0.0;
+        for k in 0..self.pair_out.len().min(self.pairs.len()) {
+            let (a, b) = (self.pairs.a[k] as usize, self.pairs.b[k] as usize);
+            let d = p.x[a] - (p.x[b] + self.pairs.shift[k]);
+            w += d.dot(&self.pair_out[k][0]);
+        }
+        w
+    }
+}
+
+impl EvalContext for Sim {
+    fn thermo(&self, name: &str) -> Option<f64> {
+        super::output::thermo_keyword(self, name)
+    }
+    fn compute(&self, id: &str, i: Option<usize>, _j: Option<usize>) -> std::result::Result<f64, String> {
+        let c = self.computes.iter().find(|c| c.id == id).ok_or_else(|| format!("compute {id} does not exist"))?;
+        c.global(self, i)
+    }
+    fn fix(&self, id: &str, i: Option<usize>, _j: Option<usize>) -> std::result::Result<f64, String> {
+        let f = self.fixes.iter().find(|f| f.id() == id).ok_or_else(|| format!("fix {id} does not exist"))?;
+        let v = match i {
+            None => f.scalar(self),
+            Some(i) => f.vector(self, i),
+        };
+        v.ok_or_else(|| format!("fix {id} ({}) has no such global value", f.style()))
+    }
+    fn atom_value(&self, keyword: &str, id: i64) -> std::result::Result<f64, String> {
+        let i = self.particles.tag.iter().position(|&t| t == id).ok_or_else(|| format!("atom {id} does not exist"))?;
+        super::compute::atom_property(self, keyword, i).ok_or_else(|| format!("unknown atom value {keyword}"))
+    }
+    fn group_function(&self, name: &str, args: &[&str]) -> std::result::Result<f64, String> {
+        super::compute::group_function(self, name, args)
+    }
+    fn natoms(&self) -> usize {
+        self.particles.len()
+    }
+    fn atom_vector(&self, keyword: &str) -> std::result::Result<Vec<f64>, String> {
+        (0..self.particles.len())
+            .map(|i| super::compute::atom_property(self, keyword, i).ok_or_else(|| format!("unknown per-atom value {keyword}")))
+            .collect()
+    }
+    fn peratom(&self, prefix: char, id: &str, col: Option<usize>) -> std::result::Result<Vec<f64>, String> {
+        if prefix == 'c' {
+            let c = self.computes.iter().find(|c| c.id == id).ok_or_else(|| format!("compute {id} does not exist"))?;
+            c.peratom(self, col)
+        } else {
+            Err(format!("per-atom fix values f_{id} are not available"))
+        }
+    }
+}

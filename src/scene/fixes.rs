@@ -1,0 +1,401 @@
+//! Simple fixes: nve/sphere, gravity, freeze, addforce, viscous, print,
+//! setforce. Each holds its group bit and parsed arguments.
+
+use super::args::Args;
+use crate::engine::fix::Fix;
+use crate::engine::integrate;
+use crate::engine::sim::Sim;
+use crate::error::{Error, Result};
+use crate::physics::V3;
+use crate::script::{Command, EvalContext, Variables};
+
+/// `fix ID group nve/sphere`.
+pub struct NveSphere {
+    /// Id.
+    pub id: String,
+    /// Group bit.
+    pub group: u32,
+}
+
+impl Fix for NveSphere {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "nve/sphere"
+    }
+    fn initial_integrate(&mut self, sim: &mut Sim) {
+        integrate::initial_integrate(&mut sim.particles, self.group, sim.dt);
+    }
+    fn final_integrate(&mut self, sim: &mut Sim) {
+        integrate::final_integrate(&mut sim.particles, self.group, sim.dt);
+    }
+    fn integrates(&self) -> bool {
+        true
+    }
+}
+
+/// `fix ID group gravity magnitude vector x y z` (also `spherical`, `chute`).
+pub struct Gravity {
+    /// Id.
+    pub id: String,
+    /// Group bit.
+    pub group: u32,
+    /// Acceleration vector (magnitude times unit direction).
+    pub acc: V3,
+    /// Magnitude, possibly a variable name.
+    pub magnitude: Magnitude,
+    /// Unit direction.
+    pub dir: V3,
+}
+
+/// A number or an equal-style variable.
+#[derive(Clone, Debug)]
+pub enum Magnitude {
+    /// Constant.
+    Const(f64),
+    /// `v_name`, evaluated every step.
+    Var(String),
+}
+
+impl Magnitude {
+    fn parse(a: &mut Args, what: &str) -> Result<Magnitude> {
+        let w = a.word(what)?;
+        if let Some(v) = w.text.strip_prefix("v_") {
+            Ok(Magnitude::Var(v.to_string()))
+        } else {
+            Ok(Magnitude::Const(super::args::parse_f64(w)?))
+        }
+    }
+    fn value(&self, vars: &Variables, ctx: &dyn EvalContext) -> Result<f64> {
+        match self {
+            Magnitude::Const(v) => Ok(*v),
+            Magnitude::Var(n) => vars.eval_equal(n, ctx).map_err(Error::runtime),
+        }
+    }
+}
+
+impl Fix for Gravity {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "gravity"
+    }
+    fn post_force(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        if let Magnitude::Var(_) = self.magnitude {
+            let m = self.magnitude.value(vars, sim)?;
+            self.acc = self.dir * m;
+        }
+        let p = &mut sim.particles;
+        for i in 0..p.len() {
+            if p.mask[i] & self.group != 0 {
+                // LAMMPS FixGravity: f += rmass * xacc (per component)
+                let m = p.mass[i];
+                p.f[i] += V3::new(m * self.acc.x, m * self.acc.y, m * self.acc.z);
+            }
+        }
+        Ok(())
+    }
+    fn summary(&self) -> String {
+        format!("gravity {:?} (fix {})", [self.acc.x, self.acc.y, self.acc.z], self.id)
+    }
+}
+
+/// `fix ID group freeze`: zero force and torque; contact partners see
+/// infinite mass.
+pub struct Freeze {
+    /// Id.
+    pub id: String,
+    /// Group bit.
+    pub group: u32,
+    /// Force removed this step (f_ID[1..3]).
+    pub removed: V3,
+}
+
+impl Fix for Freeze {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "freeze"
+    }
+    fn setup(&mut self, sim: &mut Sim) -> Result<()> {
+        let p = &mut sim.particles;
+        for i in 0..p.len() {
+            if p.mask[i] & self.group != 0 {
+                p.frozen[i] = true;
+            }
+        }
+        Ok(())
+    }
+    fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
+        let p = &mut sim.particles;
+        self.removed = V3::zeros();
+        for i in 0..p.len() {
+            if p.mask[i] & self.group != 0 {
+                p.frozen[i] = true;
+                self.removed += p.f[i];
+                p.f[i] = V3::zeros();
+                p.torque[i] = V3::zeros();
+            }
+        }
+        Ok(())
+    }
+    fn vector(&self, _sim: &Sim, i: usize) -> Option<f64> {
+        (1..=3).contains(&i).then(|| self.removed[i - 1])
+    }
+}
+
+/// One component of addforce/setforce: constant, equal- or atom-style variable, or NULL.
+#[derive(Clone, Debug)]
+pub enum Component {
+    /// A constant.
+    Const(f64),
+    /// `v_name` (equal or atom style).
+    Var(String),
+    /// `NULL` (setforce: leave alone).
+    Null,
+}
+
+fn component(a: &mut Args, what: &str) -> Result<Component> {
+    let w = a.word(what)?;
+    if w.text == "NULL" {
+        return Ok(Component::Null);
+    }
+    if let Some(v) = w.text.strip_prefix("v_") {
+        return Ok(Component::Var(v.to_string()));
+    }
+    Ok(Component::Const(super::args::parse_f64(w)?))
+}
+
+fn component_values(c: &Component, vars: &Variables, sim: &Sim) -> Result<Option<Vec<f64>>> {
+    let n = sim.particles.len();
+    Ok(match c {
+        Component::Null => None,
+        Component::Const(v) => Some(vec![*v; n]),
+        Component::Var(name) => match vars.eval_atom(name, sim) {
+            Ok(v) => Some(v),
+            Err(_) => Some(vec![vars.eval_equal(name, sim).map_err(|e| Error::runtime(format!("fix addforce: {e}")))?; n]),
+        },
+    })
+}
+
+/// `fix ID group addforce fx fy fz` and `setforce`.
+pub struct AddForce {
+    /// Id.
+    pub id: String,
+    /// Group bit.
+    pub group: u32,
+    /// Components.
+    pub comp: [Component; 3],
+    /// setforce instead of addforce.
+    pub set: bool,
+    /// Sum of the group's force before the fix (f_ID[1..3]).
+    pub total: V3,
+}
+
+impl Fix for AddForce {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        if self.set {
+            "setforce"
+        } else {
+            "addforce"
+        }
+    }
+    fn post_force(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        let vals = [
+            component_values(&self.comp[0], vars, sim)?,
+            component_values(&self.comp[1], vars, sim)?,
+            component_values(&self.comp[2], vars, sim)?,
+        ];
+        let p = &mut sim.particles;
+        self.total = V3::zeros();
+        for i in 0..p.len() {
+            if p.mask[i] & self.group == 0 {
+                continue;
+            }
+            self.total += p.f[i];
+            for d in 0..3 {
+                if let Some(v) = &vals[d] {
+                    if self.set {
+                        p.f[i][d] = v[i];
+                    } else {
+                        p.f[i][d] += v[i];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+    fn vector(&self, _sim: &Sim, i: usize) -> Option<f64> {
+        (1..=3).contains(&i).then(|| self.total[i - 1])
+    }
+}
+
+/// `fix ID group viscous gamma [scale type ratio]`: F = -gamma v.
+pub struct Viscous {
+    /// Id.
+    pub id: String,
+    /// Group bit.
+    pub group: u32,
+    /// gamma per type (index = type).
+    pub gamma: Vec<f64>,
+}
+
+impl Fix for Viscous {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "viscous"
+    }
+    fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
+        let p = &mut sim.particles;
+        for i in 0..p.len() {
+            if p.mask[i] & self.group != 0 {
+                let g = self.gamma.get(p.kind[i] as usize).copied().unwrap_or(self.gamma[0]);
+                p.f[i] -= p.v[i] * g;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `fix ID group print N "text" [file f | append f] [screen yes/no] [title t]`.
+pub struct Print {
+    /// Id.
+    pub id: String,
+    /// Every N steps.
+    pub every: i64,
+    /// Text with `$` references, substituted when printed.
+    pub text: String,
+    /// Output file.
+    pub file: Option<std::fs::File>,
+    /// Print to screen.
+    pub screen: bool,
+}
+
+impl Fix for Print {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "print"
+    }
+    fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        use std::io::Write;
+        if self.every <= 0 || sim.step % self.every != 0 {
+            return Ok(());
+        }
+        let line = vars.substitute_text(&self.text, sim).map_err(|e| Error::runtime(format!("fix print {}: {e}", self.id)))?;
+        if self.screen {
+            sim.log.line(&line);
+        }
+        if let Some(f) = &mut self.file {
+            let _ = writeln!(f, "{line}");
+            let _ = f.flush();
+        }
+        Ok(())
+    }
+}
+
+/// Parse the simple fixes; `None` if the style is not one of them.
+pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, cmd: &Command) -> Result<Option<Box<dyn Fix>>> {
+    let id = id.to_string();
+    Ok(Some(match style {
+        "nve/sphere" => {
+            while a.more() {
+                let k = a.choice("nve/sphere keyword", &["update", "disc"])?;
+                if k.text == "update" {
+                    a.choice("update style", &["dipole", "dipole/dlm"])?;
+                } else {
+                    return Err(crate::error::Error::unsupported(k.span, "fix nve/sphere disc (2d discs)"));
+                }
+            }
+            Box::new(NveSphere { id, group })
+        }
+        "gravity" => {
+            let magnitude = Magnitude::parse(a, "magnitude")?;
+            let kind = a.choice("gravity style", &["vector", "spherical", "chute"])?;
+            let dir = match kind.text.as_str() {
+                "vector" => V3::new(a.f64("x")?, a.f64("y")?, a.f64("z")?),
+                "chute" => {
+                    let ang = a.f64("angle")?.to_radians();
+                    V3::new(ang.sin(), 0.0, -ang.cos())
+                }
+                _ => {
+                    let phi = a.f64("phi")?.to_radians();
+                    let theta = a.f64("theta")?.to_radians();
+                    V3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+                }
+            };
+            let len = dir.norm();
+            if len == 0.0 {
+                return Err(a.err_prev("fix gravity: direction vector is zero"));
+            }
+            let dir = dir / len;
+            let m = if let Magnitude::Const(m) = magnitude { m } else { 0.0 };
+            Box::new(Gravity { id, group, acc: dir * m, magnitude, dir })
+        }
+        "freeze" => Box::new(Freeze { id, group, removed: V3::zeros() }),
+        "addforce" | "setforce" => {
+            let comp = [component(a, "fx")?, component(a, "fy")?, component(a, "fz")?];
+            while a.more() {
+                let k = a.choice("addforce keyword", &["every", "region", "energy"])?;
+                let w = a.word("value")?;
+                if k.text != "every" {
+                    return Err(crate::error::Error::unsupported(w.span, format!("fix {style} {}", k.text)));
+                }
+            }
+            Box::new(AddForce { id, group, comp, set: style == "setforce", total: V3::zeros() })
+        }
+        "viscous" => {
+            let g = a.f64("gamma")?;
+            let mut gamma = vec![g; sim.ntypes.max(1) + 1];
+            while a.more() {
+                a.choice("viscous keyword", &["scale"])?;
+                let t = a.i64("type")? as usize;
+                let r = a.f64("ratio")?;
+                if t < gamma.len() {
+                    gamma[t] = g * r;
+                }
+            }
+            Box::new(Viscous { id, group, gamma })
+        }
+        "print" => {
+            let every = a.i64("N")?;
+            let text = a.str("text")?.to_string();
+            let mut file = None;
+            let mut screen = true;
+            while a.more() {
+                let k = a.choice("print keyword", &["file", "append", "screen", "title"])?;
+                match k.text.as_str() {
+                    "file" | "append" => {
+                        let w = a.word("file name")?;
+                        let f = if k.text == "file" {
+                            std::fs::File::create(&w.text)
+                        } else {
+                            std::fs::OpenOptions::new().create(true).append(true).open(&w.text)
+                        };
+                        file = Some(f.map_err(|e| Error::io(w.span, format!("cannot open '{}'", w.text), &e))?);
+                    }
+                    "screen" => screen = a.yes_no("screen")?,
+                    _ => {
+                        let t = a.str("title")?;
+                        if let Some(f) = &mut file {
+                            use std::io::Write;
+                            let _ = writeln!(f, "{t}");
+                        }
+                    }
+                }
+            }
+            let _ = cmd;
+            Box::new(Print { id, every, text, file, screen })
+        }
+        _ => return Ok(None),
+    }))
+}

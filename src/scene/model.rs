@@ -1,0 +1,688 @@
+//! The contact model: `pair_style`, `pair_coeff`, `fix property/global`, and
+//! the walls that share the model (`fix wall/gran`). The kernel for a scene is
+//! chosen here, once: [`build_kernel`] walks the four model axes with one
+//! generic function per axis, so every combination compiles and the chosen
+//! one carries no per-contact branch on effects the scene does not use.
+
+use super::args::{bad_keyword, parse_f64, Args};
+use super::Session;
+use crate::engine::kernel::{ContactKernel, Laws, ParamTable};
+use crate::engine::sim::{Dialect, PairModel};
+use crate::error::{Error, Result};
+use crate::physics::normal::{self, granular::{GranularDamping, GranularNormal}};
+use crate::physics::tangential::{self, granular::GranularTangential};
+use crate::physics::{CohesionLaw, NoCohesion, NoRolling, NormalLaw, PairParams, RollingLaw, TangentialLaw};
+use crate::script::{Command, Span, Variables, Word};
+
+/// Normal law of a scene.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum NormalSpec {
+    /// LIGGGHTS `model hooke`.
+    LigHooke {
+        /// `ktToKnUser on`.
+        kt_to_kn: bool,
+    },
+    /// LIGGGHTS `model hooke/stiffness`.
+    LigHookeStiffness {
+        /// `absolute_damping on`.
+        absolute: bool,
+    },
+    /// LIGGGHTS `model hertz`.
+    LigHertz,
+    /// LIGGGHTS `model hertz/stiffness`.
+    LigHertzStiffness,
+    /// LAMMPS `gran/hooke*`.
+    GranHooke,
+    /// LAMMPS `gran/hertz/history`.
+    GranHertz,
+    /// LAMMPS `pair_style granular`.
+    #[serde(skip)]
+    Granular(GranularNormal, GranularDamping),
+}
+
+/// Tangential law of a scene.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum TangentialSpec {
+    /// LIGGGHTS `tangential no_history`.
+    LigNoHistory,
+    /// LIGGGHTS `tangential history`.
+    LigHistory,
+    /// LAMMPS `gran/hooke` (no shear history).
+    GranNoHistory,
+    /// LAMMPS `gran/*/history`.
+    GranHistory,
+    /// LAMMPS granular `linear_nohistory`.
+    LinearNoHistory,
+    /// LAMMPS granular history models.
+    #[serde(skip)]
+    Granular(GranularTangential),
+}
+
+/// Cohesion law.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum CohesionSpec {
+    /// None.
+    Off,
+}
+
+/// Rolling law.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum RollingSpec {
+    /// None.
+    Off,
+}
+
+/// The declared contact model.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PairSpec {
+    /// Where `pair_style` was written.
+    #[serde(skip)]
+    pub span: Span,
+    /// Normal law.
+    pub normal: NormalSpec,
+    /// Tangential law.
+    pub tangential: TangentialSpec,
+    /// Cohesion.
+    pub cohesion: CohesionSpec,
+    /// Rolling.
+    pub rolling: RollingSpec,
+    /// LIGGGHTS `tangential_damping` (default on) / LAMMPS dampflag.
+    pub tangential_damping: bool,
+    /// LIGGGHTS `limitForce` / LAMMPS `limit_damping`.
+    pub limit_damping: bool,
+    /// LAMMPS gran/* coefficients: Kn Kt gamma_n gamma_t xmu.
+    pub gran: Option<[f64; 5]>,
+    /// LAMMPS granular coefficients per type pair.
+    #[serde(skip)]
+    pub granular: Vec<(u32, u32, PairParams)>,
+    /// Whether `pair_coeff` was given.
+    pub has_coeff: bool,
+}
+
+impl PairSpec {
+    /// `hertz + tangential history` etc.
+    pub fn summary(&self) -> String {
+        let n = match self.normal {
+            NormalSpec::LigHooke { .. } => "hooke (LIGGGHTS)".to_string(),
+            NormalSpec::LigHookeStiffness { .. } => "hooke/stiffness (LIGGGHTS)".into(),
+            NormalSpec::LigHertz => "hertz (LIGGGHTS)".into(),
+            NormalSpec::LigHertzStiffness => "hertz/stiffness (LIGGGHTS)".into(),
+            NormalSpec::GranHooke => "hooke (LAMMPS gran)".into(),
+            NormalSpec::GranHertz => "hertz (LAMMPS gran)".into(),
+            NormalSpec::Granular(m, d) => format!("{m:?} damping {d:?} (LAMMPS granular)").to_lowercase(),
+        };
+        let t = match self.tangential {
+            TangentialSpec::LigNoHistory | TangentialSpec::GranNoHistory | TangentialSpec::LinearNoHistory => "tangential no_history".to_string(),
+            TangentialSpec::LigHistory | TangentialSpec::GranHistory => "tangential history".into(),
+            TangentialSpec::Granular(g) => format!("tangential {g:?}").to_lowercase(),
+        };
+        format!("{n} + {t}; cohesion: none; rolling: none")
+    }
+}
+
+// ---------------------------------------------------------------- kernel choice
+
+/// Build the kernel for a spec: one generic step per model axis.
+pub fn build_kernel(spec: &PairSpec) -> Box<dyn ContactKernel> {
+    match spec.normal {
+        NormalSpec::LigHooke { kt_to_kn } => with_tangential(normal::hooke::LiggghtsHooke { kt_to_kn }, spec),
+        NormalSpec::LigHookeStiffness { absolute } => {
+            with_tangential(normal::hooke_stiffness::LiggghtsHookeStiffness { absolute_damping: absolute }, spec)
+        }
+        NormalSpec::LigHertz => with_tangential(normal::hertz::LiggghtsHertz, spec),
+        NormalSpec::LigHertzStiffness => with_tangential(normal::hertz_stiffness::LiggghtsHertzStiffness, spec),
+        NormalSpec::GranHooke => with_tangential(normal::gran::LammpsGranHooke, spec),
+        NormalSpec::GranHertz => with_tangential(normal::gran::LammpsGranHertz, spec),
+        NormalSpec::Granular(model, damping) => with_tangential(normal::granular::LammpsGranular { model, damping }, spec),
+    }
+}
+
+fn with_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Box<dyn ContactKernel> {
+    match spec.tangential {
+        TangentialSpec::LigNoHistory => with_cohesion(n, tangential::no_history::LiggghtsNoHistory, spec),
+        TangentialSpec::LigHistory => with_cohesion(n, tangential::history::LiggghtsHistory, spec),
+        TangentialSpec::GranNoHistory => with_cohesion(n, tangential::gran::LammpsGranNoHistory, spec),
+        TangentialSpec::GranHistory => with_cohesion(n, tangential::gran::LammpsGranHistory, spec),
+        TangentialSpec::LinearNoHistory => with_cohesion(n, tangential::granular::LammpsLinearNoHistory, spec),
+        TangentialSpec::Granular(model) => with_cohesion(n, tangential::granular::LammpsGranularHistory { model }, spec),
+    }
+}
+
+fn with_cohesion<N: NormalLaw + Send + 'static, T: TangentialLaw + Send + 'static>(n: N, t: T, spec: &PairSpec) -> Box<dyn ContactKernel> {
+    match spec.cohesion {
+        CohesionSpec::Off => with_rolling(n, t, NoCohesion, spec),
+    }
+}
+
+fn with_rolling<N, T, C>(n: N, t: T, c: C, spec: &PairSpec) -> Box<dyn ContactKernel>
+where
+    N: NormalLaw + Send + 'static,
+    T: TangentialLaw + Send + 'static,
+    C: CohesionLaw + Send + 'static,
+{
+    match spec.rolling {
+        RollingSpec::Off => finish(n, t, c, NoRolling),
+    }
+}
+
+fn finish<N, T, C, R>(normal: N, tangential: T, cohesion: C, rolling: R) -> Box<dyn ContactKernel>
+where
+    N: NormalLaw + Send + 'static,
+    T: TangentialLaw + Send + 'static,
+    C: CohesionLaw + Send + 'static,
+    R: RollingLaw + Send + 'static,
+{
+    Box::new(Laws { normal, tangential, cohesion, rolling })
+}
+
+// ---------------------------------------------------------------- pair_style
+
+/// `pair_style` and `pair_coeff`.
+pub fn execute(s: &mut Session, cmd: &Command) -> Result<()> {
+    let mut a = Args::new(cmd);
+    if cmd.name() == "pair_coeff" {
+        let Some(spec) = s.pair.as_mut() else {
+            return Err(Error::deck(cmd.words[0].span, "pair_coeff before pair_style"));
+        };
+        let ti = a.word("type I")?;
+        let tj = a.word("type J")?;
+        spec.has_coeff = true;
+        if let NormalSpec::Granular(..) = spec.normal {
+            let ntypes = s.sim.ntypes.max(1) as u32;
+            let (ilo, ihi) = type_range(ti, ntypes)?;
+            let (jlo, jhi) = type_range(tj, ntypes)?;
+            let (normal, tang, pp) = parse_granular_coeff(&mut a)?;
+            // demx runs one granular sub-model per scene
+            let first = spec.granular.is_empty();
+            if !first {
+                if let (NormalSpec::Granular(m, d), TangentialSpec::Granular(_) | TangentialSpec::LinearNoHistory) = (spec.normal, spec.tangential) {
+                    if normal != NormalSpec::Granular(m, d) || tang != spec.tangential {
+                        return Err(Error::unsupported(cmd.span, "different pair_style granular sub-models for different type pairs"));
+                    }
+                }
+            }
+            spec.normal = normal;
+            spec.tangential = tang;
+            for i in ilo..=ihi {
+                for j in jlo..=jhi {
+                    spec.granular.push((i, j, pp));
+                    spec.granular.push((j, i, pp));
+                }
+            }
+        } else if a.more() {
+            let w = a.word("")?;
+            return Err(Error::deck(w.span, format!("pair_coeff: unexpected argument '{}' for this pair style", w.text))
+                .with_hint("granular pair styles of LIGGGHTS and LAMMPS gran/* take `pair_coeff * *` only"));
+        }
+        return Ok(());
+    }
+    let style = a.word("pair style")?;
+    let mut spec = PairSpec {
+        span: cmd.span,
+        normal: NormalSpec::LigHertz,
+        tangential: TangentialSpec::LigNoHistory,
+        cohesion: CohesionSpec::Off,
+        rolling: RollingSpec::Off,
+        tangential_damping: true,
+        limit_damping: false,
+        gran: None,
+        granular: vec![],
+        has_coeff: false,
+    };
+    match style.text.as_str() {
+        "none" => {
+            s.pair = None;
+            return Ok(());
+        }
+        "gran" => {
+            s.set_dialect(Dialect::Liggghts);
+            parse_liggghts_model(&mut a, &mut spec)?;
+        }
+        "gran/hooke" | "gran/hooke/history" | "gran/hertz/history" => {
+            let looks_legacy = a.rest().len() < 6 || a.rest().iter().take(6).any(|w| parse_f64(w).is_err() && w.text != "NULL");
+            if looks_legacy {
+                return Err(Error::unsupported(style.span, format!("LIGGGHTS 1.x/2.x syntax 'pair_style {}'", style.text))
+                    .with_hint("LIGGGHTS 3.8 rejects it too; `demx convert DECK --to liggghts` rewrites it as `pair_style gran model ...`"));
+            }
+            s.set_dialect(Dialect::Lammps);
+            let kn = a.f64("Kn")?;
+            let kt_w = a.word("Kt")?;
+            let gn = a.f64("gamma_n")?;
+            let gt_w = a.word("gamma_t")?;
+            let xmu = a.f64("xmu")?;
+            let dampflag = a.i64("dampflag")?;
+            let kt = if kt_w.text == "NULL" { 2.0 / 7.0 * kn } else { parse_f64(kt_w)? };
+            let gt = if gt_w.text == "NULL" { 0.5 * gn } else { parse_f64(gt_w)? };
+            if !(0..=1).contains(&dampflag) {
+                return Err(a.err_prev("dampflag must be 0 or 1"));
+            }
+            spec.tangential_damping = dampflag == 1;
+            spec.gran = Some([kn, kt, gn, if dampflag == 0 { 0.0 } else { gt }, xmu]);
+            while a.more() {
+                a.choice("keyword", &["limit_damping"])?;
+                spec.limit_damping = true;
+            }
+            spec.normal = if style.text == "gran/hertz/history" { NormalSpec::GranHertz } else { NormalSpec::GranHooke };
+            spec.tangential = if style.text == "gran/hooke" { TangentialSpec::GranNoHistory } else { TangentialSpec::GranHistory };
+            spec.has_coeff = false;
+        }
+        "granular" => {
+            s.set_dialect(Dialect::Lammps);
+            spec.normal = NormalSpec::Granular(GranularNormal::Hertz, GranularDamping::Viscoelastic);
+            spec.tangential = TangentialSpec::LinearNoHistory;
+            if a.more() {
+                a.f64("cutoff")?;
+            }
+        }
+        other => {
+            return Err(match other {
+                "hybrid" | "hybrid/overlay" | "gran/hooke/history/omp" => Error::unsupported(style.span, format!("pair_style {other}")),
+                _ => bad_keyword(style, "pair style", &["gran", "gran/hooke", "gran/hooke/history", "gran/hertz/history", "granular", "none"])
+                    .with_hint("demx runs granular pair styles only"),
+            })
+        }
+    }
+    s.pair = Some(spec);
+    Ok(())
+}
+
+fn type_range(w: &Word, ntypes: u32) -> Result<(u32, u32)> {
+    let t = w.text.as_str();
+    let parse = |x: &str, d: u32| -> Result<u32> {
+        if x.is_empty() {
+            Ok(d)
+        } else {
+            x.parse::<u32>().map_err(|_| Error::deck(w.span, format!("bad atom type '{}'", w.text)))
+        }
+    };
+    let (lo, hi) = match t.find('*') {
+        Some(k) => (parse(&t[..k], 1)?, parse(&t[k + 1..], ntypes)?),
+        None => {
+            let v = parse(t, 1)?;
+            (v, v)
+        }
+    };
+    if lo < 1 || hi > ntypes || lo > hi {
+        return Err(Error::deck(w.span, format!("atom type '{}' out of range 1..{}", w.text, ntypes)));
+    }
+    Ok((lo, hi))
+}
+
+/// LIGGGHTS `model M tangential T cohesion C rolling_friction R surface S kw v`.
+pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
+    a.choice("keyword", &["model"])?;
+    let m = a.word("normal model")?;
+    spec.normal = match m.text.as_str() {
+        "hooke" => NormalSpec::LigHooke { kt_to_kn: false },
+        "hooke/stiffness" => NormalSpec::LigHookeStiffness { absolute: false },
+        "hertz" => NormalSpec::LigHertz,
+        "hertz/stiffness" => NormalSpec::LigHertzStiffness,
+        "hooke/hysteresis" | "edinburgh" | "edinburgh/stiffness" | "luding" | "thornton_ning" => {
+            return Err(Error::unsupported(m.span, format!("LIGGGHTS normal model '{}'", m.text)))
+        }
+        _ => return Err(bad_keyword(m, "normal model", &["hooke", "hooke/stiffness", "hertz", "hertz/stiffness"])),
+    };
+    while a.more() {
+        let k = a.word("keyword")?;
+        match k.text.as_str() {
+            "tangential" => {
+                let t = a.word("tangential model")?;
+                spec.tangential = match t.text.as_str() {
+                    "no_history" => TangentialSpec::LigNoHistory,
+                    "history" => TangentialSpec::LigHistory,
+                    "tan_luding" => return Err(Error::unsupported(t.span, "LIGGGHTS tangential model 'tan_luding'")),
+                    _ => return Err(bad_keyword(t, "tangential model", &["no_history", "history"])),
+                };
+            }
+            "cohesion" => {
+                let c = a.word("cohesion model")?;
+                return Err(match c.text.as_str() {
+                    "sjkr" | "sjkr2" | "easo/capillary/viscous" | "washino/capillary/viscous" => {
+                        Error::unsupported(c.span, format!("cohesion model '{}'", c.text))
+                    }
+                    "off" => continue,
+                    _ => bad_keyword(c, "cohesion model", &["off", "sjkr", "sjkr2"]),
+                });
+            }
+            "rolling_friction" => {
+                let r = a.word("rolling model")?;
+                return Err(match r.text.as_str() {
+                    "off" => continue,
+                    "cdt" | "epsd" | "epsd2" | "epsd3" | "luding" => Error::unsupported(r.span, format!("rolling_friction model '{}'", r.text)),
+                    _ => bad_keyword(r, "rolling_friction model", &["off", "cdt", "epsd", "epsd2", "epsd3"]),
+                });
+            }
+            "surface" => {
+                let sfc = a.word("surface model")?;
+                match sfc.text.as_str() {
+                    "default" => {}
+                    "multicontact" | "superquadric" => return Err(Error::unsupported(sfc.span, format!("surface model '{}'", sfc.text))),
+                    _ => return Err(bad_keyword(sfc, "surface model", &["default"])),
+                }
+            }
+            "tangential_damping" => spec.tangential_damping = a.yes_no("tangential_damping")?,
+            "limitForce" => spec.limit_damping = a.yes_no("limitForce")?,
+            "ktToKnUser" => {
+                let on = a.yes_no("ktToKnUser")?;
+                if let NormalSpec::LigHooke { kt_to_kn } = &mut spec.normal {
+                    *kt_to_kn = on;
+                }
+            }
+            "absolute_damping" => {
+                let on = a.yes_no("absolute_damping")?;
+                if let NormalSpec::LigHookeStiffness { absolute } = &mut spec.normal {
+                    *absolute = on;
+                }
+            }
+            "heating_normal_hertz" | "computeDissipatedEnergy" | "computeElasticPotential" | "disableNormalWhenBonded" | "torsionTorque"
+            | "tangential_reduce" => {
+                let v = a.yes_no(&k.text.clone())?;
+                if v && k.text != "computeDissipatedEnergy" && k.text != "computeElasticPotential" {
+                    return Err(Error::unsupported(k.span, format!("model option {} on", k.text)));
+                }
+            }
+            "viscous" => return Err(Error::unsupported(k.span, "hooke model option viscous")),
+            _ => {
+                return Err(bad_keyword(
+                    k,
+                    "pair_style gran keyword",
+                    &["tangential", "cohesion", "rolling_friction", "surface", "tangential_damping", "limitForce", "ktToKnUser", "absolute_damping"],
+                ))
+            }
+        }
+    }
+    Ok(())
+}
+
+/// LAMMPS `pair_coeff I J <normal> ... tangential ... [damping ...] [rolling ...] [twisting ...] [limit_damping]`.
+fn parse_granular_coeff(a: &mut Args) -> Result<(NormalSpec, TangentialSpec, PairParams)> {
+    let mut pp = PairParams::default();
+    let m = a.word("normal model")?;
+    let model = match m.text.as_str() {
+        "hooke" => GranularNormal::Hooke,
+        "hertz" => GranularNormal::Hertz,
+        "hertz/material" => GranularNormal::HertzMaterial,
+        "dmt" | "jkr" => return Err(Error::unsupported(m.span, format!("pair_style granular normal model '{}'", m.text))),
+        _ => return Err(bad_keyword(m, "normal model", &["hooke", "hertz", "hertz/material", "dmt", "jkr"])),
+    };
+    let mut e_young = 0.0;
+    let mut poisson = 0.0;
+    match model {
+        GranularNormal::HertzMaterial => {
+            e_young = a.f64("E")?;
+            pp.gamma_n = a.f64("damping")?;
+            poisson = a.f64("poisson")?;
+            pp.poisson = poisson;
+            // E_eff for `pair_coeff` of identical materials: E / (2 (1 - nu^2)); k_n = 4/3 E_eff
+            pp.y_eff = e_young / (2.0 * (1.0 - poisson * poisson));
+            pp.kn = 4.0 / 3.0 * pp.y_eff;
+        }
+        _ => {
+            pp.kn = a.f64("kn")?;
+            pp.gamma_n = a.f64("damping")?;
+        }
+    }
+    let mut damping = GranularDamping::Viscoelastic;
+    let mut tang = None;
+    while a.more() {
+        let k = a.word("keyword")?;
+        match k.text.as_str() {
+            "tangential" => {
+                let t = a.word("tangential model")?;
+                let g = |x| TangentialSpec::Granular(x);
+                let spec = match t.text.as_str() {
+                    "linear_nohistory" => {
+                        pp.gamma_t = a.f64("x_gamma_t")?;
+                        pp.mu = a.f64("mu")?;
+                        TangentialSpec::LinearNoHistory
+                    }
+                    "linear_history" | "mindlin" | "mindlin_rescale" | "mindlin/force" | "mindlin_rescale/force" => {
+                        let ktw = a.word("kt")?;
+                        let model = match t.text.as_str() {
+                            "linear_history" => GranularTangential::LinearHistory,
+                            "mindlin" => GranularTangential::Mindlin,
+                            "mindlin_rescale" => GranularTangential::MindlinRescale,
+                            "mindlin/force" => GranularTangential::MindlinForce,
+                            _ => GranularTangential::MindlinRescaleForce,
+                        };
+                        pp.kt = if ktw.text == "NULL" {
+                            if model == GranularTangential::LinearHistory || model != GranularTangential::LinearHistory && e_young == 0.0 {
+                                return Err(Error::deck(ktw.span, "kt NULL needs normal model hertz/material"));
+                            }
+                            // 8 G_eff with G = E / (2 (1 + nu)), identical materials
+                            let g = e_young / (2.0 * (1.0 + poisson));
+                            8.0 / (2.0 * (2.0 - poisson) / g)
+                        } else {
+                            parse_f64(ktw)?
+                        };
+                        pp.gamma_t = a.f64("x_gamma_t")?;
+                        pp.mu = a.f64("mu")?;
+                        g(model)
+                    }
+                    _ => {
+                        return Err(bad_keyword(
+                            t,
+                            "tangential model",
+                            &["linear_nohistory", "linear_history", "mindlin", "mindlin_rescale", "mindlin/force", "mindlin_rescale/force"],
+                        ))
+                    }
+                };
+                tang = Some(spec);
+            }
+            "damping" => {
+                let d = a.word("damping model")?;
+                damping = match d.text.as_str() {
+                    "velocity" => GranularDamping::Velocity,
+                    "mass_velocity" => GranularDamping::MassVelocity,
+                    "viscoelastic" => GranularDamping::Viscoelastic,
+                    "tsuji" => GranularDamping::Tsuji,
+                    "coeff_restitution" => return Err(Error::unsupported(d.span, "damping coeff_restitution (not in LAMMPS 29 Sep 2021)")),
+                    _ => return Err(bad_keyword(d, "damping model", &["velocity", "mass_velocity", "viscoelastic", "tsuji"])),
+                };
+            }
+            "rolling" | "twisting" => return Err(Error::unsupported(k.span, format!("pair_style granular {} models", k.text))),
+            "limit_damping" => pp.limit_damping = 1.0,
+            "cutoff" => {
+                a.f64("cutoff")?;
+            }
+            _ => return Err(bad_keyword(k, "pair_coeff keyword", &["tangential", "damping", "rolling", "twisting", "limit_damping", "cutoff"])),
+        }
+    }
+    let Some(tang) = tang else {
+        return Err(Error::deck(a.end_span(), "pair_coeff: the tangential model is required for pair_style granular"));
+    };
+    if damping == GranularDamping::Tsuji {
+        // alpha(e) from the restitution given as the damping coefficient (LAMMPS doc)
+        let e = pp.gamma_n;
+        pp.gamma_n = 1.2728 - 4.2783 * e + 11.087 * e * e - 22.348 * e.powi(3) + 27.467 * e.powi(4) - 18.022 * e.powi(5) + 4.8218 * e.powi(6);
+    }
+    pp.tangential_damping = 1.0;
+    Ok((NormalSpec::Granular(model, damping), tang, pp))
+}
+
+// ---------------------------------------------------------------- materials
+
+/// Values of a `fix property/global` entry as a matrix lookup.
+fn prop<'a>(s: &'a Session, name: &str) -> Option<&'a Vec<f64>> {
+    s.props.get(name).map(|(_, v)| v)
+}
+
+/// Fill the coefficient table for particle types (and the same table serves
+/// LIGGGHTS walls: wall type T uses row T).
+pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable> {
+    let nt = s.sim.ntypes.max(1);
+    let mut t = ParamTable::new(nt);
+    match spec.normal {
+        NormalSpec::GranHooke | NormalSpec::GranHertz => {
+            let [kn, kt, gn, gt, mu] = spec.gran.unwrap_or_default();
+            for p in t.params.iter_mut() {
+                p.kn = kn;
+                p.kt = kt;
+                p.gamma_n = gn;
+                p.gamma_t = gt;
+                p.mu = mu;
+                p.tangential_damping = if spec.tangential_damping { 1.0 } else { 0.0 };
+                p.limit_damping = if spec.limit_damping { 1.0 } else { 0.0 };
+            }
+        }
+        NormalSpec::Granular(..) => {
+            for &(i, j, pp) in &spec.granular {
+                if (i as usize) <= nt && (j as usize) <= nt {
+                    *t.get_mut(i, j) = pp;
+                }
+            }
+        }
+        _ => {
+            let need = |name: &str| -> Result<&Vec<f64>> {
+                prop(s, name).ok_or_else(|| {
+                    Error::deck(span, format!("pair_style gran needs `fix ID all property/global {name} ...`"))
+                        .with_hint("LIGGGHTS reads material properties from fix property/global")
+                })
+            };
+            let per_type = |name: &str, v: &Vec<f64>, i: usize| -> Result<f64> {
+                v.get(i - 1).copied().ok_or_else(|| Error::deck(span, format!("property/global {name} has {} values, needs one per atom type ({nt})", v.len())))
+            };
+            let per_pair = |name: &str, v: &Vec<f64>, i: usize, j: usize| -> Result<f64> {
+                // stored as N then N*N values
+                let n = v.first().copied().unwrap_or(0.0) as usize;
+                if n < nt || v.len() < 1 + n * n {
+                    return Err(Error::deck(span, format!("property/global {name} must be peratomtypepair {nt} with {} values", nt * nt)));
+                }
+                Ok(v[1 + (i - 1) * n + (j - 1)])
+            };
+            let stiff = matches!(spec.normal, NormalSpec::LigHookeStiffness { .. } | NormalSpec::LigHertzStiffness);
+            let y = if stiff { None } else { Some(need("youngsModulus")?) };
+            let nu = if stiff { None } else { Some(need("poissonsRatio")?) };
+            let e = if stiff { None } else { Some(need("coefficientRestitution")?) };
+            let mu = if matches!(spec.tangential, TangentialSpec::LigHistory | TangentialSpec::LigNoHistory) {
+                Some(need("coefficientFriction")?)
+            } else {
+                None
+            };
+            let cv = if matches!(spec.normal, NormalSpec::LigHooke { .. }) { Some(need("characteristicVelocity")?) } else { None };
+            for i in 1..=nt {
+                for j in 1..=nt {
+                    let mut p = PairParams::default();
+                    if let (Some(y), Some(nu)) = (y, nu) {
+                        let (yi, yj) = (per_type("youngsModulus", y, i)?, per_type("youngsModulus", y, j)?);
+                        let (ni, nj) = (per_type("poissonsRatio", nu, i)?, per_type("poissonsRatio", nu, j)?);
+                        if s.units == super::Units::Si && (yi > 1e9 || yj > 1e9) && !s.hard_particles {
+                            return Err(Error::deck(span, format!("youngsModulus {} > 1e9 needs `hard_particles yes` (as in LIGGGHTS)", yi.max(yj)))
+                                .with_hint("add `hard_particles yes` before the pair_style"));
+                        }
+                        let m = crate::physics::mixing::liggghts_moduli(yi, ni, yj, nj);
+                        p.y_eff = m.0;
+                        p.g_eff = m.1;
+                    }
+                    if let Some(e) = e {
+                        let ev = per_pair("coefficientRestitution", e, i, j)?;
+                        p.restitution = ev;
+                        p.beta = crate::physics::mixing::liggghts_beta(ev);
+                    }
+                    if let Some(mu) = mu {
+                        p.mu = per_pair("coefficientFriction", mu, i, j)?;
+                    }
+                    if let Some(cv) = cv {
+                        p.char_vel = cv.first().copied().unwrap_or(0.0);
+                    }
+                    if stiff {
+                        for (name, field) in [("kn", 0), ("kt", 1), ("gamman", 2), ("gammat", 3)] {
+                            let alt = format!("{name}_abs");
+                            let v = prop(s, name).or_else(|| prop(s, &alt)).ok_or_else(|| {
+                                Error::deck(span, format!("model {:?} needs `fix ID all property/global {name} peratomtypepair ...`", spec.normal))
+                            })?;
+                            let val = per_pair(name, v, i, j)?;
+                            match field {
+                                0 => p.kn = val,
+                                1 => p.kt = val,
+                                2 => p.gamma_n = val,
+                                _ => p.gamma_t = val,
+                            }
+                        }
+                    }
+                    p.tangential_damping = if spec.tangential_damping { 1.0 } else { 0.0 };
+                    p.limit_damping = if spec.limit_damping { 1.0 } else { 0.0 };
+                    *t.get_mut(i as u32, j as u32) = p;
+                }
+            }
+        }
+    }
+    Ok(t)
+}
+
+/// Before a run: build the kernel and coefficient table from the spec.
+pub fn finalize(s: &mut Session, _cmd: &Command) -> Result<()> {
+    let Some(spec) = s.pair.clone() else {
+        s.sim.model = None;
+        return Ok(());
+    };
+    if matches!(spec.normal, NormalSpec::Granular(..)) && spec.granular.is_empty() {
+        return Err(Error::deck(spec.span, "pair_style granular needs pair_coeff lines"));
+    }
+    if !spec.has_coeff && !matches!(spec.normal, NormalSpec::GranHooke | NormalSpec::GranHertz) {
+        return Err(Error::deck(spec.span, "all pair coeffs are not set").with_hint("add `pair_coeff * *` after pair_style"));
+    }
+    let table = fill_table(s, &spec, spec.span)?;
+    let kernel = build_kernel(&spec);
+    s.sim.model = Some(PairModel { kernel, table, summary: spec.summary() });
+    Ok(())
+}
+
+// ---------------------------------------------------------------- fixes that need the model
+
+/// `fix property/global`, `fix wall/gran`, and the rest of the fix styles.
+pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
+    let _ = vars;
+    match style.text.as_str() {
+        "property/global" => {
+            let name = a.word("property name")?;
+            let kind = a.choice("property style", &["scalar", "vector", "peratomtype", "peratomtypepair", "atomtype", "atomtypepair", "matrix"])?;
+            let mut vals = vec![];
+            for w in a.rest() {
+                vals.push(parse_f64(w)?);
+            }
+            if vals.is_empty() {
+                return Err(Error::deck(a.end_span(), format!("property/global {}: no values", name.text)));
+            }
+            let _ = id;
+            s.props.insert(name.text.clone(), (kind.text.clone(), vals));
+            Ok(())
+        }
+        "property/atom" => {
+            let name = a.word("property name")?;
+            a.choice("style", &["scalar", "vector"])?;
+            a.word("restart yes/no")?;
+            a.word("communicate yes/no")?;
+            a.word("reverse yes/no")?;
+            let mut vals = vec![];
+            for w in a.rest() {
+                vals.push(parse_f64(w)?);
+            }
+            s.sim.particles.add_extra(&name.text, vals);
+            Ok(())
+        }
+        "check/timestep/gran" | "enforce2d" | "momentum" => {
+            s.notes.push((cmd.span, format!("fix {}: accepted; demx reports timestep criteria in `demx check`", style.text)));
+            Ok(())
+        }
+        "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" | "insert/pack" | "insert/stream"
+        | "insert/rate/region" | "particletemplate/sphere" | "particledistribution/discrete" | "pour" | "ave/time" => {
+            super::setup::extended_fix(s, cmd, id, group, style, a, vars)
+        }
+        other => {
+            let lig = [
+                "mesh/surface/stress", "mesh/surface/stress/servo", "couple/cfd", "couple/cfd/force", "heat/gran", "multisphere",
+                "particletemplate/multisphere", "massflow/mesh", "ave/euler", "property/atom/tracer", "wall/region/sph",
+                "insert/pack/dense", "nve/sphere/omp", "ave/chunk", "ave/atom", "deform", "rigid", "spring", "langevin", "nvt", "npt",
+                "wall/reflect", "wall/region", "store/state", "ave/histo", "heat/flow", "temp/rescale", "balance", "dt/reset",
+                "adapt", "python/invoke", "wiggle/mesh", "mesh/gran", "nve", "recenter", "setforce/region", "lineforce", "planeforce",
+                "efield", "wall/lj93",
+            ];
+            if lig.contains(&other) || other.contains('/') {
+                Err(Error::unsupported(style.span, format!("fix {other}")))
+            } else {
+                Err(bad_keyword(style, "fix style", &["nve/sphere", "gravity", "freeze", "addforce", "viscous", "wall/gran", "property/global", "insert/pack", "pour", "print"]))
+            }
+        }
+    }
+}

@@ -1,0 +1,400 @@
+//! Output commands: thermo, thermo_style, thermo_modify, dump, dump_modify,
+//! undump, compute, uncompute.
+
+use super::args::{bad_keyword, Args};
+use super::Session;
+use crate::engine::compute::{Compute, ComputeKind};
+use crate::engine::output::{Dump, LostPolicy};
+use crate::engine::sim::{Dialect, Sim};
+use crate::error::{Error, Result};
+use crate::io::dump::{DumpOptions, DumpWriter, Engine, Frame, FormatSpec, SortBy};
+use crate::script::{Command, Variables};
+
+/// Execute an output command.
+pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<()> {
+    let _ = vars;
+    let mut a = Args::new(cmd);
+    match cmd.name() {
+        "thermo" => {
+            let w = a.word("N")?;
+            if let Some(v) = w.text.strip_prefix("v_") {
+                return Err(Error::unsupported(w.span, format!("thermo v_{v} (variable thermo interval)")));
+            }
+            s.sim.thermo.every = super::args::parse_i64(w)?;
+            Ok(())
+        }
+        "thermo_style" => {
+            let st = a.choice("thermo style", &["one", "multi", "custom", "yaml"])?;
+            match st.text.as_str() {
+                "one" => {
+                    s.sim.thermo.keywords = ["step", "temp", "epair", "emol", "etotal", "press"].iter().map(|k| k.to_string()).collect();
+                }
+                "custom" => {
+                    let mut ks = vec![];
+                    for w in a.rest() {
+                        check_thermo_keyword(s, w)?;
+                        ks.push(w.text.clone());
+                    }
+                    if ks.is_empty() {
+                        return Err(Error::deck(a.end_span(), "thermo_style custom: no keywords"));
+                    }
+                    s.sim.thermo.keywords = ks;
+                }
+                other => return Err(Error::unsupported(st.span, format!("thermo_style {other}"))),
+            }
+            Ok(())
+        }
+        "thermo_modify" => {
+            while a.more() {
+                let k = a.word("keyword")?;
+                match k.text.as_str() {
+                    "lost" => {
+                        let v = a.choice("lost policy", &["error", "warn", "ignore"])?;
+                        s.sim.thermo.lost = match v.text.as_str() {
+                            "error" => LostPolicy::Error,
+                            "warn" => LostPolicy::Warn,
+                            _ => LostPolicy::Ignore,
+                        };
+                    }
+                    "norm" => s.sim.thermo.norm = a.yes_no("norm")?,
+                    "flush" | "line" => {
+                        a.word("value")?;
+                    }
+                    "lost/bond" | "temp" | "press" => {
+                        a.word("value")?;
+                    }
+                    "every" => {
+                        a.word("value")?;
+                    }
+                    "format" => {
+                        let what = a.word("format target")?;
+                        let f = a.str("format")?.to_string();
+                        match what.text.as_str() {
+                            "line" => s.sim.thermo.format_line = Some(f),
+                            "int" => s.sim.thermo.format_int = Some(f),
+                            "float" => s.sim.thermo.format_float = Some(f),
+                            "none" => {
+                                s.sim.thermo.format_line = None;
+                                s.sim.thermo.format_int = None;
+                                s.sim.thermo.format_float = None;
+                                s.sim.thermo.format_col.clear();
+                            }
+                            n => {
+                                let col: usize = n.parse().map_err(|_| bad_keyword(what, "format target", &["line", "int", "float", "N"]))?;
+                                s.sim.thermo.format_col.push((col, f));
+                            }
+                        }
+                    }
+                    _ => return Err(bad_keyword(k, "thermo_modify keyword", &["lost", "norm", "flush", "format", "line", "temp", "press"])),
+                }
+            }
+            Ok(())
+        }
+        "compute" => compute_command(s, &mut a),
+        "uncompute" => {
+            let w = a.word("compute id")?;
+            let before = s.sim.computes.len();
+            s.sim.computes.retain(|c| c.id != w.text);
+            if s.sim.computes.len() == before {
+                return Err(Error::deck(w.span, format!("uncompute: compute '{}' does not exist", w.text)));
+            }
+            Ok(())
+        }
+        "dump" => dump_command(s, cmd, &mut a),
+        "dump_modify" => {
+            let w = a.word("dump id")?;
+            let k = s.sim.dumps.iter().position(|d| d.id() == w.text).ok_or_else(|| Error::deck(w.span, format!("dump_modify: dump '{}' does not exist", w.text)))?;
+            let rest = a.rest();
+            s.sim.dumps[k].modify(rest)
+        }
+        "undump" => {
+            let w = a.word("dump id")?;
+            let before = s.sim.dumps.len();
+            s.sim.dumps.retain(|d| d.id() != w.text);
+            if s.sim.dumps.len() == before {
+                return Err(Error::deck(w.span, format!("undump: dump '{}' does not exist", w.text)));
+            }
+            Ok(())
+        }
+        _ => unreachable!("outputs::execute dispatched a command it does not handle"),
+    }
+}
+
+fn check_thermo_keyword(s: &Session, w: &crate::script::Word) -> Result<()> {
+    let k = w.text.as_str();
+    if k.starts_with("c_") || k.starts_with("f_") || k.starts_with("v_") {
+        return Ok(());
+    }
+    if crate::engine::output::thermo_keyword(&s.sim, k).is_some() {
+        return Ok(());
+    }
+    const OTHER: &[&str] = &["enthalpy", "ecouple", "econserve", "xy", "xz", "yz", "pxx", "pyy", "pzz", "pxy", "pxz", "pyz", "fmax", "fnorm", "part", "timeremain", "tpcpu", "lat", "bonds", "angles", "dihedrals", "impropers", "cella", "cellb", "cellc", "cellalpha", "cellbeta", "cellgamma", "evdwl", "ecoul", "epair", "ebond", "eangle", "edihed", "eimp", "emol", "elong", "etail", "xlat", "ylat", "zlat", "nbuild", "ndanger"];
+    if OTHER.contains(&k) {
+        return Err(Error::unsupported(w.span, format!("thermo keyword {k}")));
+    }
+    Err(Error::deck(w.span, format!("unknown thermo keyword '{k}'")))
+}
+
+fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
+    let id = a.word("compute id")?;
+    let g = a.word("group")?;
+    let group = s.group(g)?;
+    let style = a.word("compute style")?;
+    let kind = match style.text.as_str() {
+        "ke" => ComputeKind::Ke,
+        "erotate/sphere" => ComputeKind::ErotateSphere,
+        "temp" => ComputeKind::Temp,
+        "com" => ComputeKind::Com,
+        "reduce" => {
+            let mode = a.choice("reduce mode", &["sum", "min", "max", "ave", "sumsq", "avesq", "sumabs", "aveabs"])?;
+            let mut inputs = vec![];
+            for w in a.rest() {
+                if ["replace", "inputs"].contains(&w.text.as_str()) {
+                    break;
+                }
+                if w.text.starts_with("v_") || w.text.starts_with("f_") {
+                    return Err(Error::unsupported(w.span, format!("compute reduce of {}", w.text)));
+                }
+                inputs.push(w.text.clone());
+            }
+            ComputeKind::Reduce { mode: mode.text.clone(), inputs }
+        }
+        "property/atom" => {
+            let mut names = vec![];
+            for w in a.rest() {
+                if crate::engine::compute::atom_property(&s.sim, &w.text, usize::MAX).is_none() && !is_atom_property_name(&w.text) {
+                    return Err(Error::unsupported(w.span, format!("compute property/atom {}", w.text)));
+                }
+                names.push(w.text.clone());
+            }
+            ComputeKind::PropertyAtom { names }
+        }
+        other => {
+            return Err(Error::unsupported(style.span, format!("compute {other}")));
+        }
+    };
+    let c = Compute { id: id.text.clone(), group, kind, style: style.text.clone() };
+    match s.sim.computes.iter().position(|x| x.id == c.id) {
+        Some(k) => s.sim.computes[k] = c,
+        None => s.sim.computes.push(c),
+    }
+    Ok(())
+}
+
+fn is_atom_property_name(n: &str) -> bool {
+    matches!(
+        n,
+        "id" | "type" | "mass" | "radius" | "diameter" | "density" | "x" | "y" | "z" | "xu" | "yu" | "zu" | "xs" | "ys" | "zs" | "ix" | "iy" | "iz" | "vx"
+            | "vy" | "vz" | "fx" | "fy" | "fz" | "omegax" | "omegay" | "omegaz" | "tqx" | "tqy" | "tqz" | "angmomx" | "angmomy" | "angmomz" | "mol" | "q"
+    )
+}
+
+/// `dump custom` / `dump atom` through [`DumpWriter`].
+pub struct DumpText {
+    id: String,
+    group: u32,
+    columns: Vec<String>,
+    writer: Option<DumpWriter>,
+    opts: DumpOptions,
+    path: String,
+    last_step: Option<i64>,
+    summary: String,
+}
+
+impl DumpText {
+    fn ensure_open(&mut self) -> Result<&mut DumpWriter> {
+        if self.writer.is_none() {
+            self.writer = Some(DumpWriter::create(&self.path, self.opts.clone())?);
+        }
+        Ok(self.writer.as_mut().expect("just opened"))
+    }
+}
+
+impl Dump for DumpText {
+    fn due(&self, step: i64, first: bool) -> bool {
+        if self.last_step == Some(step) {
+            return false;
+        }
+        let every = self.opts.every as i64;
+        (every > 0 && step % every == 0) || (first && self.opts.first)
+    }
+    fn write(&mut self, sim: &Sim) -> Result<()> {
+        if sim.dry {
+            return Ok(());
+        }
+        self.last_step = Some(sim.step);
+        let p = &sim.particles;
+        let rows: Vec<usize> = (0..p.len()).filter(|&i| p.mask[i] & self.group != 0).collect();
+        let input_cols: Vec<String> = match self.opts.style {
+            crate::io::dump::DumpStyle::Custom => self.columns.clone(),
+            crate::io::dump::DumpStyle::Atom => ["id", "type", "x", "y", "z", "ix", "iy", "iz"].iter().map(|s| s.to_string()).collect(),
+        };
+        let mut values = Vec::with_capacity(rows.len() * input_cols.len());
+        let mut col_vals: Vec<Vec<f64>> = Vec::with_capacity(input_cols.len());
+        for c in &input_cols {
+            col_vals.push(column_values(sim, c)?);
+        }
+        for &i in &rows {
+            for cv in &col_vals {
+                values.push(cv[i]);
+            }
+        }
+        let d = sim.domain.as_ref().ok_or_else(|| Error::runtime("dump before the box exists"))?;
+        let b = d.boundary_strings();
+        let bounds = crate::io::dump::BoxBounds::orthogonal(d.lo, d.hi, &format!("{} {} {}", b[0], b[1], b[2]));
+        let frame = Frame { timestep: sim.step.max(0) as u64, time: Some(sim.time), natoms: rows.len(), bounds, columns: input_cols, values };
+        self.ensure_open()?.write_frame(&frame)
+    }
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn modify(&mut self, args: &[crate::script::Word]) -> Result<()> {
+        let mut k = 0;
+        while k < args.len() {
+            let w = &args[k];
+            let val = |n: usize| args.get(k + n).ok_or_else(|| Error::deck(w.span, format!("dump_modify {}: missing value", w.text)));
+            match w.text.as_str() {
+                "format" => {
+                    let what = val(1)?;
+                    match what.text.as_str() {
+                        "line" => {
+                            self.opts.formats.push(FormatSpec::Line(val(2)?.text.clone()));
+                            k += 3;
+                        }
+                        "float" => {
+                            self.opts.formats.push(FormatSpec::Float(val(2)?.text.clone()));
+                            k += 3;
+                        }
+                        "int" => {
+                            self.opts.formats.push(FormatSpec::Int(val(2)?.text.clone()));
+                            k += 3;
+                        }
+                        "none" => {
+                            self.opts.formats.push(FormatSpec::None);
+                            k += 2;
+                        }
+                        n => match n.parse::<usize>() {
+                            Ok(c) => {
+                                self.opts.formats.push(FormatSpec::Column(c, val(2)?.text.clone()));
+                                k += 3;
+                            }
+                            Err(_) => {
+                                // LIGGGHTS: `format "%d %d %g ..."` (whole line)
+                                self.opts.formats.push(FormatSpec::Line(what.text.clone()));
+                                k += 2;
+                            }
+                        },
+                    }
+                }
+                "sort" => {
+                    let v = val(1)?;
+                    self.opts.sort = match v.text.as_str() {
+                        "off" => None,
+                        "id" => Some(SortBy::Id),
+                        t => {
+                            let n: i64 = t.parse().map_err(|_| Error::deck(v.span, "dump_modify sort: expected off, id or a column number"))?;
+                            Some(SortBy::Column(n.unsigned_abs() as usize, n < 0))
+                        }
+                    };
+                    k += 2;
+                }
+                "scale" | "image" | "first" | "append" => {
+                    let v = val(1)?;
+                    let on = matches!(v.text.as_str(), "yes" | "on");
+                    match w.text.as_str() {
+                        "scale" => self.opts.scale = on,
+                        "image" => self.opts.image = on,
+                        "first" => self.opts.first = on,
+                        _ => self.opts.append = on,
+                    }
+                    k += 2;
+                }
+                "pad" => {
+                    self.opts.pad = super::args::parse_i64(val(1)?)?.max(0) as usize;
+                    k += 2;
+                }
+                "every" => {
+                    self.opts.every = super::args::parse_i64(val(1)?)?.max(0) as u64;
+                    k += 2;
+                }
+                "flush" | "units" | "time" | "precision" | "colname" | "header" | "delay" => {
+                    k += 2;
+                }
+                "label" | "element" | "region" | "thresh" | "refresh" | "fileper" | "nfile" => {
+                    return Err(Error::unsupported(w.span, format!("dump_modify {}", w.text)));
+                }
+                _ => return Err(bad_keyword(w, "dump_modify keyword", &["format", "sort", "scale", "image", "first", "append", "pad", "every", "flush"])),
+            }
+        }
+        // a reopened writer picks the new options up
+        if self.writer.is_some() && self.writer.as_ref().map(|w| w.frames_written()).unwrap_or(0) == 0 {
+            self.writer = None;
+        }
+        Ok(())
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+}
+
+fn column_values(sim: &Sim, c: &str) -> Result<Vec<f64>> {
+    use crate::script::EvalContext;
+    if let Some(rest) = c.strip_prefix("c_") {
+        let (id, col) = match rest.find('[') {
+            Some(b) => (&rest[..b], rest[b + 1..].trim_end_matches(']').parse().ok()),
+            None => (rest, None),
+        };
+        return sim.peratom('c', id, col).map_err(|e| Error::runtime(format!("dump column {c}: {e}")));
+    }
+    sim.atom_vector(c).map_err(|e| Error::runtime(format!("dump column {c}: {e}")))
+}
+
+fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    let id = a.word("dump id")?;
+    let g = a.word("group")?;
+    let group = s.group(g)?;
+    let style = a.word("dump style")?;
+    let every = a.i64("N")?;
+    let file = a.word("file")?;
+    let engine = if s.sim.dialect == Dialect::Liggghts { Engine::Liggghts } else { Engine::Lammps };
+    let (opts, columns) = match style.text.as_str() {
+        "custom" | "custom/gz" => {
+            let mut cols = vec![];
+            for w in a.rest() {
+                let t = w.text.as_str();
+                let known = is_atom_property_name(t) || t.starts_with("c_") || t.starts_with("f_") || t.starts_with("v_");
+                if !known {
+                    return Err(Error::deck(w.span, format!("dump custom: unknown column '{t}'")));
+                }
+                if t.starts_with("f_") || t.starts_with("v_") {
+                    return Err(Error::unsupported(w.span, format!("dump custom column {t}")));
+                }
+                if let Some(rest) = t.strip_prefix("c_") {
+                    let cid = rest.split('[').next().unwrap_or("");
+                    if !s.sim.computes.iter().any(|c| c.id == cid) {
+                        return Err(Error::deck(w.span, format!("dump custom: compute '{cid}' does not exist")));
+                    }
+                }
+                cols.push(t.to_string());
+            }
+            if cols.is_empty() {
+                return Err(Error::deck(a.end_span(), "dump custom: no columns"));
+            }
+            let refs: Vec<&str> = cols.iter().map(|s| s.as_str()).collect();
+            (DumpOptions::custom(engine, every.max(0) as u64, &refs), cols)
+        }
+        "atom" | "atom/gz" => (DumpOptions::atom(engine, every.max(0) as u64), vec![]),
+        "custom/vtk" | "mesh/stl" | "mesh/vtk" | "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "stl" | "mesh/gran/VTK" | "vtk" | "decomposition/vtk" | "euler/vtk" => {
+            return Err(Error::unsupported(style.span, format!("dump {}", style.text)));
+        }
+        _ => return Err(bad_keyword(style, "dump style", &["custom", "atom", "custom/vtk", "mesh/stl"])),
+    };
+    let _ = cmd;
+    let summary = format!("dump {} {} every {} -> {}", id.text, style.text, every, file.text);
+    let d = DumpText { id: id.text.clone(), group, columns, writer: None, opts, path: file.text.clone(), last_step: None, summary };
+    if let Some(k) = s.sim.dumps.iter().position(|x| x.id() == id.text) {
+        return Err(Error::deck(id.span, format!("dump '{}' already exists (k={k})", id.text)).with_hint("undump it first"));
+    }
+    s.sim.dumps.push(Box::new(d));
+    Ok(())
+}

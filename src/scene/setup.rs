@@ -1,0 +1,641 @@
+//! Setup commands: units, box, regions, lattices, atoms, groups, settings;
+//! and the fixes that need geometry (walls, insertion).
+
+use super::args::{bad_keyword, parse_f64, Args};
+use super::{Session, Units};
+use crate::engine::domain::{Domain, Side};
+use crate::engine::particles::NewParticle;
+use crate::error::{Error, Result};
+use crate::geom::{parse_lattice, parse_region, Region, RegionParseCtx};
+use crate::physics::V3;
+use crate::script::{Command, Variables, Word};
+
+/// Execute a setup command.
+pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<()> {
+    let mut a = Args::new(cmd);
+    match cmd.name() {
+        "units" => {
+            let u = a.choice("unit style", &["si", "lj", "cgs", "metal", "real", "micro", "nano", "electron"])?;
+            s.units = match u.text.as_str() {
+                "si" => Units::Si,
+                "lj" => Units::Lj,
+                "cgs" => Units::Cgs,
+                other => return Err(Error::unsupported(u.span, format!("units {other}"))),
+            };
+            let (boltz, skin) = match s.units {
+                Units::Si => (1.380649e-23, 0.001),
+                Units::Lj => (1.0, 0.3),
+                Units::Cgs => (1.380649e-16, 0.1),
+            };
+            s.sim.boltz = boltz;
+            s.sim.neigh.skin = skin;
+            Ok(())
+        }
+        "atom_style" => {
+            let st = a.word("atom style")?;
+            match st.text.as_str() {
+                "sphere" | "granular" => {
+                    s.atom_style = Some(st.text.clone());
+                    Ok(())
+                }
+                "hybrid" => {
+                    let ok = a.rest().iter().all(|w| matches!(w.text.as_str(), "sphere" | "granular"));
+                    if ok {
+                        Ok(())
+                    } else {
+                        Err(Error::unsupported(st.span, format!("atom_style {}", cmd.text().trim_start_matches("atom_style "))))
+                    }
+                }
+                "atomic" | "bond" | "molecular" | "full" | "charge" | "body" | "line" | "tri" | "ellipsoid" | "superquadric"
+                | "dipole" | "bpm/sphere" => Err(Error::unsupported(st.span, format!("atom_style {}", st.text)).with_hint("demx simulates spheres: atom_style sphere or granular")),
+                _ => Err(bad_keyword(st, "atom style", &["sphere", "granular"])),
+            }
+        }
+        "boundary" => {
+            let mut sides = [[Side::Periodic; 2]; 3];
+            for d in 0..3 {
+                let w = a.word("boundary")?;
+                let chars: Vec<char> = w.text.chars().collect();
+                let pair = match chars.len() {
+                    1 => [chars[0], chars[0]],
+                    2 => [chars[0], chars[1]],
+                    _ => return Err(Error::deck(w.span, format!("illegal boundary '{}'", w.text)).with_hint("use p, f, s, m or two of them such as fm")),
+                };
+                for k in 0..2 {
+                    sides[d][k] = Side::from_char(pair[k]).ok_or_else(|| Error::deck(w.span, format!("illegal boundary letter '{}' (expected p, f, s, m)", pair[k])))?;
+                }
+                if (sides[d][0] == Side::Periodic) != (sides[d][1] == Side::Periodic) {
+                    return Err(Error::deck(w.span, "both sides of a periodic dimension must be periodic"));
+                }
+            }
+            match s.sim.domain.as_mut() {
+                Some(d) => d.sides = sides,
+                None => s.pending_sides = Some(sides),
+            }
+            Ok(())
+        }
+        "dimension" => {
+            let d = a.i64("dimension")?;
+            if d != 2 && d != 3 {
+                return Err(a.err_prev("dimension must be 2 or 3"));
+            }
+            s.dimension = d as u8;
+            Ok(())
+        }
+        "neighbor" => {
+            s.sim.neigh.skin = a.f64("skin")?;
+            let st = a.word("neighbor style")?;
+            match st.text.as_str() {
+                "bin" | "nsq" | "multi" => Ok(()),
+                _ => Err(bad_keyword(st, "neighbor style", &["bin", "nsq", "multi"])),
+            }
+        }
+        "neigh_modify" => {
+            while a.more() {
+                let k = a.word("keyword")?;
+                match k.text.as_str() {
+                    "delay" => s.sim.neigh.delay = a.i64("delay")?,
+                    "every" => s.sim.neigh.every = a.i64("every")?,
+                    "check" => s.sim.neigh.check = a.yes_no("check")?,
+                    "once" | "cluster" => {
+                        a.yes_no(&k.text.clone())?;
+                    }
+                    "page" | "one" | "binsize" => {
+                        a.f64(&k.text.clone())?;
+                    }
+                    "exclude" => {
+                        let kind = a.choice("exclude style", &["type", "group", "molecule/intra", "molecule/inter", "none"])?;
+                        match kind.text.as_str() {
+                            "type" => {
+                                let i = a.i64("type I")? as u32;
+                                let j = a.i64("type J")? as u32;
+                                s.sim.neigh.exclude_types.push((i, j));
+                            }
+                            "group" => {
+                                let g1 = a.word("group 1")?;
+                                let g2 = a.word("group 2")?;
+                                let (b1, b2) = (s.group(g1)?, s.group(g2)?);
+                                s.sim.neigh.exclude_groups.push((b1, b2));
+                            }
+                            "none" => {
+                                s.sim.neigh.exclude_types.clear();
+                                s.sim.neigh.exclude_groups.clear();
+                            }
+                            _ => return Err(Error::unsupported(kind.span, format!("neigh_modify exclude {}", kind.text))),
+                        }
+                    }
+                    "contact_distance_factor" => {
+                        a.f64("factor")?;
+                    }
+                    _ => return Err(bad_keyword(k, "neigh_modify keyword", &["delay", "every", "check", "once", "page", "one", "exclude", "binsize"])),
+                }
+            }
+            Ok(())
+        }
+        "timestep" => {
+            let dt = a.f64("timestep")?;
+            if !(dt > 0.0) {
+                return Err(a.err_prev("timestep must be positive"));
+            }
+            s.sim.dt = dt;
+            Ok(())
+        }
+        "hard_particles" | "soft_particles" => {
+            let on = a.yes_no(cmd.name())?;
+            if cmd.name() == "hard_particles" {
+                s.hard_particles = on;
+            }
+            Ok(())
+        }
+        "reset_timestep" => {
+            let n = a.i64("step")?;
+            s.sim.step = n;
+            Ok(())
+        }
+        "region" => {
+            let ctx = RegionParseCtx { lattice: lattice_spacing(s), box_bounds: box_bounds(s), regions: &s.regions };
+            let r = parse_region(cmd, &ctx)?;
+            let _ = vars;
+            match s.regions.iter().position(|x| x.id == r.id) {
+                Some(k) => {
+                    return Err(Error::deck(cmd.args()[0].span, format!("region '{}' is already defined", r.id)));
+                }
+                None => s.regions.push(r),
+            }
+            let _ = Some(0).map(|k: usize| k);
+            Ok(())
+        }
+        "lattice" => {
+            let l = parse_lattice(cmd, s.units == Units::Lj, s.dimension as usize)?;
+            s.lattice = Some(l);
+            Ok(())
+        }
+        "create_box" => {
+            if s.sim.domain.is_some() {
+                return Err(Error::deck(cmd.words[0].span, "create_box: box already exists"));
+            }
+            let n = a.i64("number of atom types")?;
+            if n < 1 {
+                return Err(a.err_prev("create_box: need at least one atom type"));
+            }
+            let rw = a.word("region")?;
+            let r = region(s, rw)?;
+            let (lo, hi) = r.bbox().ok_or_else(|| Error::deck(rw.span, format!("create_box: region '{}' has no finite bounding box", rw.text)))?;
+            while a.more() {
+                // LIGGGHTS/LAMMPS extra keywords (bond/types, extra/...): accept numbers
+                a.word("keyword")?;
+                if a.more() {
+                    a.word("value")?;
+                }
+            }
+            make_box(s, n as usize, lo, hi);
+            Ok(())
+        }
+        "create_atoms" => create_atoms(s, cmd, &mut a),
+        "read_data" => read_data(s, cmd, &mut a),
+        "group" => group_command(s, cmd, &mut a),
+        "set" => set_command(s, cmd, &mut a),
+        "velocity" => velocity_command(s, cmd, &mut a),
+        "mass" => {
+            a.word("type")?;
+            a.f64("mass")?;
+            s.notes.push((cmd.span, "mass: ignored for atom_style sphere (per-particle mass from density and radius)".into()));
+            Ok(())
+        }
+        "delete_atoms" => delete_atoms(s, cmd, &mut a),
+        "displace_atoms" => {
+            s.need_box(cmd)?;
+            let g = a.word("group")?;
+            let bit = s.group(g)?;
+            let k = a.choice("style", &["move", "ramp", "random", "rotate"])?;
+            if k.text != "move" {
+                return Err(Error::unsupported(k.span, format!("displace_atoms {}", k.text)));
+            }
+            let d = V3::new(a.f64("dx")?, a.f64("dy")?, a.f64("dz")?);
+            let mut scale = lattice_spacing(s);
+            while a.more() {
+                a.choice("keyword", &["units"])?;
+                if a.choice("units", &["box", "lattice"])?.text == "box" {
+                    scale = V3::new(1.0, 1.0, 1.0);
+                }
+            }
+            let d = d.component_mul(&scale);
+            let p = &mut s.sim.particles;
+            for i in 0..p.len() {
+                if p.mask[i] & bit != 0 {
+                    p.x[i] += d;
+                }
+            }
+            s.sim.force_rebuild = true;
+            Ok(())
+        }
+        "write_data" | "write_restart" | "read_restart" => Err(Error::unsupported(cmd.words[0].span, format!("command '{}'", cmd.name()))),
+        _ => unreachable!("setup::execute dispatched a command it does not handle"),
+    }
+}
+
+fn make_box(s: &mut Session, ntypes: usize, lo: V3, hi: V3) {
+    let sides = s.pending_sides.unwrap_or([[Side::Periodic; 2]; 3]);
+    s.sim.domain = Some(Domain::new([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z], sides, s.dimension));
+    s.sim.ntypes = ntypes;
+}
+
+/// Lattice spacings for `units lattice` (1,1,1 without a lattice).
+pub fn lattice_spacing(s: &Session) -> V3 {
+    s.lattice.as_ref().map(|l| l.spacing()).unwrap_or(V3::new(1.0, 1.0, 1.0))
+}
+
+fn box_bounds(s: &Session) -> Option<(V3, V3)> {
+    s.sim.domain.as_ref().map(|d| (V3::new(d.lo[0], d.lo[1], d.lo[2]), V3::new(d.hi[0], d.hi[1], d.hi[2])))
+}
+
+/// A region by id, with a did-you-mean error.
+pub fn region<'a>(s: &'a Session, w: &Word) -> Result<&'a Region> {
+    s.regions.iter().find(|r| r.id == w.text).ok_or_else(|| {
+        let mut e = Error::deck(w.span, format!("region '{}' does not exist", w.text));
+        if let Some(h) = crate::error::did_you_mean(&w.text, s.regions.iter().map(|r| r.id.as_str())) {
+            e = e.with_hint(format!("did you mean '{h}'?"));
+        }
+        e
+    })
+}
+
+fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    let t = a.i64("atom type")?;
+    if t < 1 || t as usize > s.sim.ntypes {
+        return Err(a.err_prev(format!("create_atoms: atom type {t} out of range 1..{}", s.sim.ntypes)));
+    }
+    let style = a.choice("style", &["box", "region", "single", "random"])?;
+    let dom = s.sim.domain.clone().ok_or_else(|| Error::runtime("no box"))?;
+    let mut points: Vec<V3> = vec![];
+    let mut single_units_lattice = true;
+    let mut region_filter: Option<Region> = None;
+    match style.text.as_str() {
+        "single" => {
+            let p = V3::new(a.f64("x")?, a.f64("y")?, a.f64("z")?);
+            points.push(p);
+        }
+        "box" => {}
+        "region" => {
+            let w = a.word("region")?;
+            region_filter = Some(region(s, w)?.clone());
+        }
+        _ => {
+            let n = a.i64("N")?;
+            let seed = a.i64("seed")?;
+            let rw = a.word("region")?;
+            if rw.text != "NULL" {
+                region_filter = Some(region(s, rw)?.clone());
+            }
+            // uniform random points in the region's box (LAMMPS uses its own RNG: ids differ)
+            let (lo, hi) = match &region_filter {
+                Some(r) => r.bbox().unwrap_or((V3::from(dom.lo), V3::from(dom.hi))),
+                None => (V3::from(dom.lo), V3::from(dom.hi)),
+            };
+            let mut rng = crate::engine::rng::Park::new(seed);
+            let mut tries = 0;
+            while (points.len() as i64) < n && tries < 1000 * n.max(1) {
+                tries += 1;
+                let p = V3::new(lo.x + rng.uniform() * (hi.x - lo.x), lo.y + rng.uniform() * (hi.y - lo.y), lo.z + rng.uniform() * (hi.z - lo.z));
+                if region_filter.as_ref().map_or(true, |r| r.contains(p)) {
+                    points.push(p);
+                }
+            }
+        }
+    }
+    while a.more() {
+        let k = a.word("keyword")?;
+        match k.text.as_str() {
+            "units" => single_units_lattice = a.choice("units", &["box", "lattice"])?.text == "lattice",
+            "basis" => {
+                a.i64("basis")?;
+                a.i64("type")?;
+            }
+            "overlap" | "maxtry" => {
+                a.f64(&k.text.clone())?;
+            }
+            _ => return Err(Error::unsupported(k.span, format!("create_atoms keyword {}", k.text))),
+        }
+    }
+    if style.text == "single" && single_units_lattice {
+        let sp = lattice_spacing(s);
+        if s.lattice.is_none() {
+            return Err(Error::deck(cmd.span, "create_atoms single with units lattice needs a lattice").with_hint("add `units box`"));
+        }
+        points[0] = points[0].component_mul(&sp);
+    }
+    if style.text == "box" || style.text == "region" {
+        let lat = s.lattice.as_ref().ok_or_else(|| Error::deck(style.span, "create_atoms: no lattice defined").with_hint("define one with the lattice command"))?;
+        let periodic = [dom.periodic(0), dom.periodic(1), dom.periodic(2)];
+        let filter = region_filter.clone();
+        let f = move |p: V3| filter.as_ref().map_or(true, |r| r.contains(p));
+        let pts = lat
+            .create_points(V3::from(dom.lo), V3::from(dom.hi), periodic, dom.dimension as usize, Some(&f))
+            .map_err(|e| Error::deck(style.span, e.message()))?;
+        points = pts.into_iter().map(|(p, _)| p).collect();
+    }
+    // LAMMPS default diameter 1, density 1 for atom_style sphere
+    let mut tag = s.sim.particles.max_tag();
+    let n = points.len();
+    for p in points {
+        tag += 1;
+        s.sim.particles.push(NewParticle { tag, kind: t as u32, mask: 1, x: p, v: V3::zeros(), omega: V3::zeros(), radius: 0.5, density: 1.0 });
+    }
+    s.sources.push(format!("create_atoms {} {}: {n} particles", t, style.text));
+    s.sim.force_rebuild = true;
+    s.sim.log.line(&format!("Created {n} atoms"));
+    Ok(())
+}
+
+fn read_data(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    let w = a.word("file")?;
+    Err(Error::unsupported(w.span, "read_data (reader not wired yet)")).map(|_: ()| {
+        let _ = (s, cmd);
+    })
+}
+
+fn group_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    let name = a.word("group name")?;
+    let style = a.word("group style")?;
+    if style.text == "delete" {
+        if let Some(k) = s.sim.groups.iter().position(|g| g == &name.text) {
+            s.sim.groups[k] = String::new();
+        }
+        return Ok(());
+    }
+    let bit = match s.sim.group_bit(&name.text) {
+        Some(b) => b,
+        None => {
+            if s.sim.groups.len() >= 32 {
+                return Err(Error::deck(name.span, "too many groups (32 at most)"));
+            }
+            s.sim.groups.push(name.text.clone());
+            1u32 << (s.sim.groups.len() - 1)
+        }
+    };
+    let p = &mut s.sim.particles;
+    let mut select = vec![false; p.len()];
+    match style.text.as_str() {
+        "type" | "id" | "molecule" => {
+            let field: Vec<i64> = if style.text == "type" { p.kind.iter().map(|&k| k as i64).collect() } else { p.tag.clone() };
+            let rest = a.rest();
+            if let Some(op) = rest.first().filter(|w| ["<", ">", "<=", ">=", "==", "!=", "<>"].contains(&w.text.as_str())) {
+                let v1 = rest.get(1).map(super::args::parse_i64).transpose()?.ok_or_else(|| Error::deck(op.span, "missing value"))?;
+                let v2 = rest.get(2).map(super::args::parse_i64).transpose()?;
+                for (i, &f) in field.iter().enumerate() {
+                    select[i] = match op.text.as_str() {
+                        "<" => f < v1,
+                        ">" => f > v1,
+                        "<=" => f <= v1,
+                        ">=" => f >= v1,
+                        "==" => f == v1,
+                        "!=" => f != v1,
+                        _ => f >= v1 && f <= v2.unwrap_or(v1),
+                    };
+                }
+            } else {
+                for w in rest {
+                    let (lo, hi, step) = parse_range(w)?;
+                    for (i, &f) in field.iter().enumerate() {
+                        if f >= lo && f <= hi && (f - lo) % step == 0 {
+                            select[i] = true;
+                        }
+                    }
+                }
+            }
+        }
+        "region" => {
+            let rw = a.word("region")?;
+            let r = s.regions.iter().find(|r| r.id == rw.text).ok_or_else(|| Error::deck(rw.span, format!("region '{}' does not exist", rw.text)))?;
+            let p = &s.sim.particles;
+            for i in 0..p.len() {
+                select[i] = r.contains(p.x[i]);
+            }
+        }
+        "empty" => {}
+        "subtract" | "union" | "intersect" => {
+            let mut bits = vec![];
+            for w in a.rest() {
+                bits.push(s.group(w)?);
+            }
+            let p = &s.sim.particles;
+            for i in 0..p.len() {
+                let has = |b: u32| p.mask[i] & b != 0;
+                select[i] = match style.text.as_str() {
+                    "union" => bits.iter().any(|&b| has(b)),
+                    "intersect" => bits.iter().all(|&b| has(b)),
+                    _ => !bits.is_empty() && has(bits[0]) && !bits[1..].iter().any(|&b| has(b)),
+                };
+            }
+        }
+        "dynamic" | "static" | "include" | "variable" => return Err(Error::unsupported(style.span, format!("group {}", style.text))),
+        _ => return Err(bad_keyword(style, "group style", &["type", "id", "region", "empty", "subtract", "union", "intersect", "delete"])),
+    }
+    let _ = cmd;
+    let p = &mut s.sim.particles;
+    let mut count = 0;
+    for i in 0..p.len() {
+        if select[i] {
+            p.mask[i] |= bit;
+        }
+        if p.mask[i] & bit != 0 {
+            count += 1;
+        }
+    }
+    s.sim.log.line(&format!("{count} atoms in group {}", name.text));
+    Ok(())
+}
+
+fn parse_range(w: &Word) -> Result<(i64, i64, i64)> {
+    let t = &w.text;
+    let bad = || Error::deck(w.span, format!("bad id/type range '{t}'"));
+    if let Some((a, b)) = t.split_once(':') {
+        let (b, step) = match b.split_once(':') {
+            Some((b, c)) => (b, c.parse::<i64>().map_err(|_| bad())?),
+            None => (b, 1),
+        };
+        Ok((a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?, step.max(1)))
+    } else if let Some(k) = t.find('*') {
+        let lo = if k == 0 { 1 } else { t[..k].parse().map_err(|_| bad())? };
+        let hi = if k + 1 == t.len() { i64::MAX } else { t[k + 1..].parse().map_err(|_| bad())? };
+        Ok((lo, hi, 1))
+    } else {
+        let v = t.parse().map_err(|_| bad())?;
+        Ok((v, v, 1))
+    }
+}
+
+fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    let style = a.choice("set style", &["atom", "type", "group", "region", "mol", "type/fraction"])?;
+    let what = a.word("ids")?;
+    let p = &s.sim.particles;
+    let select: Vec<bool> = match style.text.as_str() {
+        "atom" | "type" => {
+            let (lo, hi, _) = parse_range(what)?;
+            (0..p.len()).map(|i| {
+                let f = if style.text == "atom" { p.tag[i] } else { p.kind[i] as i64 };
+                f >= lo && f <= hi
+            }).collect()
+        }
+        "group" => {
+            let b = s.group(what)?;
+            (0..p.len()).map(|i| p.mask[i] & b != 0).collect()
+        }
+        "region" => {
+            let r = region(s, what)?;
+            (0..p.len()).map(|i| r.contains(p.x[i])).collect()
+        }
+        _ => return Err(Error::unsupported(style.span, format!("set {}", style.text))),
+    };
+    let mut count = 0;
+    while a.more() {
+        let k = a.word("keyword")?;
+        let v = a.word("value")?;
+        let val = parse_f64(v)?;
+        let p = &mut s.sim.particles;
+        count = 0;
+        for i in 0..p.len() {
+            if !select[i] {
+                continue;
+            }
+            count += 1;
+            match k.text.as_str() {
+                "diameter" => {
+                    p.radius[i] = 0.5 * val;
+                    p.mass[i] = crate::engine::particles::Particles::sphere_mass(p.radius[i], p.density[i]);
+                }
+                "density" => {
+                    p.density[i] = val;
+                    p.mass[i] = crate::engine::particles::Particles::sphere_mass(p.radius[i], val);
+                }
+                "mass" => {
+                    p.mass[i] = val;
+                    p.density[i] = val / crate::engine::particles::Particles::sphere_mass(p.radius[i], 1.0);
+                }
+                "type" => p.kind[i] = val as u32,
+                "vx" => p.v[i].x = val,
+                "vy" => p.v[i].y = val,
+                "vz" => p.v[i].z = val,
+                "omega" => return Err(Error::unsupported(k.span, "set omega (use velocity or omega per component)")),
+                "x" => p.x[i].x = val,
+                "y" => p.x[i].y = val,
+                "z" => p.x[i].z = val,
+                _ => return Err(Error::unsupported(k.span, format!("set keyword {}", k.text))),
+            }
+        }
+        s.sim.log.line(&format!("  {count} settings made for {}", k.text));
+    }
+    let _ = count;
+    s.sim.force_rebuild = true;
+    Ok(())
+}
+
+fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    let g = a.word("group")?;
+    let bit = s.group(g)?;
+    let style = a.choice("velocity style", &["set", "create", "zero", "ramp", "scale"])?;
+    match style.text.as_str() {
+        "set" => {
+            let mut comp = [None; 3];
+            for c in comp.iter_mut() {
+                let w = a.word("component")?;
+                if w.text != "NULL" {
+                    *c = Some(parse_f64(w)?);
+                }
+            }
+            let mut sum = false;
+            let mut scale = lattice_spacing(s);
+            while a.more() {
+                let k = a.choice("keyword", &["units", "sum", "dist", "mom", "rot", "loop", "temp", "bias", "rigid"])?;
+                match k.text.as_str() {
+                    "units" => {
+                        if a.choice("units", &["box", "lattice"])?.text == "box" {
+                            scale = V3::new(1.0, 1.0, 1.0);
+                        }
+                    }
+                    "sum" => sum = a.yes_no("sum")?,
+                    _ => {
+                        a.word("value")?;
+                    }
+                }
+            }
+            let p = &mut s.sim.particles;
+            for i in 0..p.len() {
+                if p.mask[i] & bit == 0 {
+                    continue;
+                }
+                for d in 0..3 {
+                    if let Some(v) = comp[d] {
+                        let v = v * scale[d];
+                        if sum {
+                            p.v[i][d] += v;
+                        } else {
+                            p.v[i][d] = v;
+                        }
+                    }
+                }
+            }
+            Ok(())
+        }
+        "zero" => {
+            let k = a.choice("zero what", &["linear", "angular"])?;
+            let p = &mut s.sim.particles;
+            if k.text == "linear" {
+                let (mut m, mut mv) = (0.0, V3::zeros());
+                for i in 0..p.len() {
+                    if p.mask[i] & bit != 0 {
+                        m += p.mass[i];
+                        mv += p.v[i] * p.mass[i];
+                    }
+                }
+                if m > 0.0 {
+                    let vc = mv / m;
+                    for i in 0..p.len() {
+                        if p.mask[i] & bit != 0 {
+                            p.v[i] -= vc;
+                        }
+                    }
+                }
+            }
+            Ok(())
+        }
+        _ => Err(Error::unsupported(style.span, format!("velocity {}", style.text))),
+    }
+}
+
+fn delete_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    let style = a.choice("style", &["group", "region", "overlap", "porosity"])?;
+    let w = a.word("argument")?;
+    let p = &s.sim.particles;
+    let remove: Vec<bool> = match style.text.as_str() {
+        "group" => {
+            let b = s.group(w)?;
+            (0..p.len()).map(|i| p.mask[i] & b != 0).collect()
+        }
+        "region" => {
+            let r = region(s, w)?;
+            (0..p.len()).map(|i| r.contains(p.x[i])).collect()
+        }
+        _ => return Err(Error::unsupported(style.span, format!("delete_atoms {}", style.text))),
+    };
+    let n = s.sim.particles.remove_where(&remove);
+    s.sim.log.line(&format!("Deleted {n} atoms, new total = {}", s.sim.particles.len()));
+    s.sim.force_rebuild = true;
+    Ok(())
+}
+
+/// Fixes that need geometry or insertion machinery.
+pub fn extended_fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
+    let _ = (cmd, id, group, a, vars);
+    match style.text.as_str() {
+        "wall/gran" => super::walls::wall_gran(s, cmd, id, group, style, a),
+        _ => {
+            s.need_box(cmd).ok();
+            Err(Error::unsupported(style.span, format!("fix {}", style.text)))
+        }
+    }
+}
