@@ -39,7 +39,7 @@ fn check(points: &[(V3, usize)], dump: &str) {
 fn fcc_box_matches_lammps_order_and_boundary_rule() {
     let lat = parse_lattice(&cmd("lattice fcc 1.0"), false, 3).unwrap();
     assert_eq!(lat.spacing(), V3::new(1.0, 1.0, 1.0));
-    let pts = lat.create_points(V3::zeros(), V3::new(2.0, 2.0, 1.5), [true, false, true], 3, None).unwrap();
+    let pts = lat.create_points(V3::zeros(), V3::new(2.0, 2.0, 1.5), [true, false, true], None).unwrap();
     check(&pts, "fcc_box.dump");
 }
 
@@ -49,7 +49,7 @@ fn hcp_oriented_with_origin_in_sphere_region_matches_lammps() {
     let ctx = RegionParseCtx { lattice: lat.spacing(), box_bounds: Some((V3::zeros(), V3::new(2.0, 2.0, 1.5))), regions: &[] };
     let ball = parse_region(&cmd("region ball sphere 1.0 1.0 0.75 1.0 units box"), &ctx).unwrap();
     let f = |p: V3| ball.contains(p);
-    let pts = lat.create_points(V3::zeros(), V3::new(2.0, 2.0, 1.5), [true, false, true], 3, Some(&f)).unwrap();
+    let pts = lat.create_points(V3::zeros(), V3::new(2.0, 2.0, 1.5), [true, false, true], Some(&f)).unwrap();
     check(&pts, "hcp_sphere.dump");
 }
 
@@ -59,7 +59,7 @@ fn sc_block_in_lattice_units_matches_lammps() {
     let ctx = RegionParseCtx { lattice: lat.spacing(), box_bounds: Some((V3::zeros(), V3::new(2.0, 2.0, 1.5))), regions: &[] };
     let blk = parse_region(&cmd("region blk block 1 6 2 8 0 4 units lattice"), &ctx).unwrap();
     let f = |p: V3| blk.contains(p);
-    let pts = lat.create_points(V3::zeros(), V3::new(2.0, 2.0, 1.5), [false; 3], 3, Some(&f)).unwrap();
+    let pts = lat.create_points(V3::zeros(), V3::new(2.0, 2.0, 1.5), [false; 3], Some(&f)).unwrap();
     check(&pts, "sc_block.dump");
 }
 
@@ -89,4 +89,16 @@ fn lattice_errors() {
     assert!(parse_lattice(&cmd("lattice fcc 1.0 origin 1.0 0 0"), false, 3).is_err());
     let e = parse_lattice(&cmd("lattice fcx 1.0"), false, 3).unwrap_err();
     assert_eq!(e.exit_code(), 2);
+}
+
+#[test]
+fn sq_2d_creates_z_layers_like_lammps() {
+    // lmp (dimension 2, boundary p p p, lattice sq 0.1, box 0..0.3 x 0..0.2 x -0.5..0.5):
+    // 60 atoms; ids 1..6 at z = -0.5, id 7 at (0, 0, -0.4).
+    let lat = parse_lattice(&cmd("lattice sq 0.1"), false, 2).unwrap();
+    let pts = lat.create_points(V3::new(0.0, 0.0, -0.5), V3::new(0.3, 0.2, 0.5), [true; 3], None).unwrap();
+    assert_eq!(pts.len(), 60);
+    assert_eq!(pts[1].0, V3::new(0.1, 0.0, -0.5));
+    assert_eq!(pts[5].0, V3::new(0.2, 0.1, -0.5));
+    assert_eq!(pts[6].0, V3::new(0.0, 0.0, -0.4));
 }

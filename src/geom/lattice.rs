@@ -14,7 +14,9 @@
 //! region (if any) and in `[lo, hi)` in every dimension, where for a periodic
 //! dimension lo is lowered by `eps` and hi lowered by `2 eps`,
 //! `eps = 1e-6 * (hi - lo)` (so points exactly on the periodic upper face
-//! are not created, points on the lower face are). In 2d only k = 0 is used.
+//! are not created, points on the lower face are). In 2d LAMMPS 29 Sep 2021
+//! does not restrict k: with a z extent larger than the z spacing it
+//! creates several z layers (checked with `lmp`); this is reproduced.
 //! Shrink-wrapped boundaries: LAMMPS `create_box` has already widened the box
 //! by 1e-4 of its length at each shrink-wrapped face, which is why points on
 //! the upper face are then created; pass that widened box.
@@ -323,7 +325,6 @@ impl Lattice {
         box_lo: V3,
         box_hi: V3,
         periodic: [bool; 3],
-        dimension: usize,
         filter: Option<&dyn Fn(V3) -> bool>,
     ) -> Result<Vec<(V3, usize)>> {
         if self.style == LatticeStyle::None || self.basis.is_empty() {
@@ -356,7 +357,7 @@ impl Lattice {
         }
         let lo: Vec<i64> = lmin.iter().map(|v| v.floor() as i64 - 1).collect();
         let hi: Vec<i64> = lmax.iter().map(|v| v.ceil() as i64 + 1).collect();
-        let (klo, khi) = if dimension == 2 { (0, 0) } else { (lo[2], hi[2]) };
+        let (klo, khi) = (lo[2], hi[2]);
         let sites = (hi[0] - lo[0] + 1) as f64 * (hi[1] - lo[1] + 1) as f64 * (khi - klo + 1) as f64 * self.basis.len() as f64;
         if sites > 1e8 {
             return Err(Error::runtime(format!("create_atoms would visit {sites:.3e} lattice sites (limit 1e8)")));
