@@ -90,6 +90,14 @@ pub struct ContactOut {
     pub kt: f64,
     /// Contact radius `a` where the law defines one (Hertz: sqrt(R* delta)).
     pub a: f64,
+    /// Normal damping coefficient in force the normal law applied
+    /// (`fn_damp = -gamma_n * vn`); LAMMPS `granular` scales its tangential
+    /// damping with it (`damp_normal_prefactor`).
+    pub gamma_n: f64,
+    /// Absolute tangential damping coefficient set by the normal law
+    /// (LIGGGHTS `sidata.gammat`; LAMMPS gran/*: m* gamma_t, times the
+    /// Hertz factor); force per unit sliding velocity.
+    pub gamma_t: f64,
     /// Tangential force on i.
     pub ft: V3,
     /// Torque on i.

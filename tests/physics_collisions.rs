@@ -1,0 +1,356 @@
+//! Two-body collisions driven by the contact laws with a small
+//! velocity-Verlet integrator written here (no engine code): contact
+//! duration against Hertz and damped-oscillator closed forms, restitution
+//! against the requested coefficient, energy and momentum of elastic
+//! impacts, and the Coulomb limit of a sphere sliding on a wall.
+
+use demx::physics::mixing::*;
+use demx::physics::normal::gran::LammpsGranHooke;
+use demx::physics::normal::hertz::LiggghtsHertz;
+use demx::physics::normal::hooke::LiggghtsHooke;
+use demx::physics::tangential::gran::LammpsGranHistory;
+use demx::physics::tangential::history::LiggghtsHistory;
+use demx::physics::*;
+use demx::script::source::{SourceMap, Span};
+use std::f64::consts::PI;
+
+const RHO: f64 = 2500.0;
+
+#[derive(Clone, Copy, Debug)]
+struct Body {
+    x: V3,
+    v: V3,
+    w: V3,
+    r: f64,
+    m: f64,
+    inertia: f64,
+}
+
+impl Body {
+    fn sphere(r: f64, x: V3, v: V3) -> Body {
+        let m = RHO * 4.0 / 3.0 * PI * r * r * r;
+        Body { x, v, w: V3::zeros(), r, m, inertia: 0.4 * m * r * r }
+    }
+}
+
+fn span() -> Span {
+    let map = SourceMap::new();
+    let id = map.add("in.test", "pair_style gran".to_string());
+    Span::new(id, 0, 4)
+}
+
+fn liggghts(y: f64, nu: f64, e: f64, mu: f64, char_vel: f64) -> PairParams {
+    let mut m = LiggghtsMaterials::default();
+    m.n_types = 1;
+    m.youngs = Some(vec![y]);
+    m.poisson = Some(vec![nu]);
+    m.restitution = Some(vec![e]);
+    m.friction = Some(vec![mu]);
+    m.char_vel = Some(char_vel);
+    liggghts_pair_params(&m, &LiggghtsSettings::default(), span()).unwrap()[0]
+}
+
+/// The wall is the plane z = 0 with normal +z.
+struct Sim<'a, N: NormalLaw, T: TangentialLaw> {
+    n: &'a N,
+    t: &'a T,
+    p: PairParams,
+    b: Vec<Body>,
+    wall: bool,
+    hist: Vec<f64>,
+    dt: f64,
+    gravity: f64,
+    f: Vec<V3>,
+    tq: Vec<V3>,
+    delta: f64,
+    fn_last: f64,
+    ft_last: V3,
+}
+
+impl<'a, N: NormalLaw, T: TangentialLaw> Sim<'a, N, T> {
+    fn new(n: &'a N, t: &'a T, p: PairParams, b: Vec<Body>, wall: bool, dt: f64, gravity: f64) -> Self {
+        let k = b.len();
+        let mut s = Sim {
+            n,
+            t,
+            p,
+            b,
+            wall,
+            hist: vec![0.0; N::HISTORY + T::HISTORY],
+            dt,
+            gravity,
+            f: vec![V3::zeros(); k],
+            tq: vec![V3::zeros(); k],
+            delta: 0.0,
+            fn_last: 0.0,
+            ft_last: V3::zeros(),
+        };
+        s.forces();
+        s
+    }
+
+    fn contact(&self) -> Contact {
+        let bi = &self.b[0];
+        if self.wall {
+            let n = V3::new(0.0, 0.0, 1.0);
+            let delta = bi.r - bi.x.z;
+            Contact {
+                n,
+                r: bi.x.z,
+                delta,
+                ri: bi.r,
+                rj: f64::INFINITY,
+                r_eff: r_eff(bi.r, f64::INFINITY),
+                mi: bi.m,
+                mj: f64::INFINITY,
+                m_eff: m_eff(bi.m, f64::INFINITY),
+                vr: bi.v,
+                vn: bi.v.dot(&n),
+                wi: bi.w,
+                wj: V3::zeros(),
+                dt: self.dt,
+            }
+        } else {
+            let bj = &self.b[1];
+            let d = bi.x - bj.x;
+            let r = d.norm();
+            let n = d / r;
+            let vr = bi.v - bj.v;
+            Contact {
+                n,
+                r,
+                delta: bi.r + bj.r - r,
+                ri: bi.r,
+                rj: bj.r,
+                r_eff: r_eff(bi.r, bj.r),
+                mi: bi.m,
+                mj: bj.m,
+                m_eff: m_eff(bi.m, bj.m),
+                vr,
+                vn: vr.dot(&n),
+                wi: bi.w,
+                wj: bj.w,
+                dt: self.dt,
+            }
+        }
+    }
+
+    fn forces(&mut self) {
+        for k in 0..self.b.len() {
+            self.f[k] = V3::new(0.0, 0.0, -self.gravity * self.b[k].m);
+            self.tq[k] = V3::zeros();
+        }
+        let c = self.contact();
+        self.delta = c.delta;
+        if c.delta > 0.0 {
+            let mut out = ContactOut::default();
+            let (hn, ht) = self.hist.split_at_mut(N::HISTORY);
+            self.n.normal(&c, &self.p, hn, &mut out);
+            self.t.tangential(&c, &self.p, ht, &mut out);
+            let fi = out.force_i(&c);
+            self.f[0] += fi;
+            self.tq[0] += out.torque_i;
+            if !self.wall {
+                self.f[1] -= fi;
+                self.tq[1] += out.torque_j;
+            }
+            self.fn_last = out.fn_for_friction;
+            self.ft_last = out.ft;
+        } else {
+            self.hist.iter_mut().for_each(|h| *h = 0.0);
+            self.fn_last = 0.0;
+            self.ft_last = V3::zeros();
+        }
+    }
+
+    /// One velocity-Verlet step (as LAMMPS/LIGGGHTS nve/sphere).
+    fn step(&mut self) {
+        let dt = self.dt;
+        for k in 0..self.b.len() {
+            let b = &mut self.b[k];
+            b.v += self.f[k] * (0.5 * dt / b.m);
+            b.w += self.tq[k] * (0.5 * dt / b.inertia);
+            b.x += b.v * dt;
+        }
+        self.forces();
+        for k in 0..self.b.len() {
+            let b = &mut self.b[k];
+            b.v += self.f[k] * (0.5 * dt / b.m);
+            b.w += self.tq[k] * (0.5 * dt / b.inertia);
+        }
+    }
+}
+
+/// Head-on impact starting at first touch; returns (contact duration,
+/// relative normal speed after / before, the final Sim bodies).
+fn impact<N: NormalLaw, T: TangentialLaw>(
+    n: &N,
+    t: &T,
+    p: PairParams,
+    b: Vec<Body>,
+    wall: bool,
+    dt: f64,
+) -> (f64, f64, Vec<Body>) {
+    let mut s = Sim::new(n, t, p, b, wall, dt, 0.0);
+    let vrel = |s: &Sim<N, T>| if s.wall { s.b[0].v.z } else { s.b[0].v.z - s.b[1].v.z };
+    let v0 = vrel(&s);
+    let mut time = 0.0;
+    let mut steps = 0usize;
+    loop {
+        let before = s.delta;
+        s.step();
+        time += dt;
+        steps += 1;
+        assert!(steps < 1_000_000, "collision did not end");
+        if steps > 2 && s.delta <= 0.0 && before > 0.0 {
+            // linear interpolation of the exit crossing
+            let tc = time - dt + dt * before / (before - s.delta);
+            return (tc, (vrel(&s) / v0).abs(), s.b);
+        }
+    }
+}
+
+/// Two equal glass-like spheres (R = 1 mm) meeting head-on at relative speed v.
+fn two_spheres(v: f64) -> Vec<Body> {
+    let r = 1e-3;
+    vec![
+        Body::sphere(r, V3::new(0.0, 0.0, r), V3::new(0.0, 0.0, -0.5 * v)),
+        Body::sphere(r, V3::new(0.0, 0.0, -r), V3::new(0.0, 0.0, 0.5 * v)),
+    ]
+}
+
+fn hertz_tc(m: f64, r: f64, e_star: f64, v: f64) -> f64 {
+    // t_c = 2.94 (15 m* / (16 E* sqrt(R*)))^(2/5) v^(-1/5) = 2.868 (m*^2/(R* E*^2 v))^(1/5)
+    2.943_8 * (15.0 * m / (16.0 * e_star * r.sqrt())).powf(0.4) * v.powf(-0.2)
+}
+
+#[test]
+fn hertz_contact_duration_matches_closed_form() {
+    let (y, nu) = (7e10, 0.25);
+    let p = liggghts(y, nu, 1.0, 0.0, 1.0);
+    let e_star = y / (2.0 * (1.0 - nu * nu));
+    for v in [0.1, 1.0, 5.0] {
+        let b = two_spheres(v);
+        let m = b[0].m / 2.0;
+        let tc = hertz_tc(m, 0.5e-3, e_star, v);
+        let (t, e, _) = impact(&LiggghtsHertz, &LiggghtsHistory, p, b, false, tc / 200.0);
+        assert!(((t - tc) / tc).abs() < 0.01, "v={v}: t={t} tc={tc}");
+        assert!((e - 1.0).abs() < 1e-6, "v={v}: e={e}");
+        // sphere on a wall: R* = R, m* = m, E* mixed with the same material
+        let b = vec![Body::sphere(1e-3, V3::new(0.0, 0.0, 1e-3), V3::new(0.0, 0.0, -v))];
+        let tc = hertz_tc(b[0].m, 1e-3, e_star, v);
+        let (t, _, _) = impact(&LiggghtsHertz, &LiggghtsHistory, p, b, true, tc / 200.0);
+        assert!(((t - tc) / tc).abs() < 0.01, "wall v={v}: t={t} tc={tc}");
+    }
+}
+
+#[test]
+fn liggghts_restitution_is_the_requested_coefficient() {
+    let (y, nu) = (7e10, 0.25);
+    for e_req in [0.3, 0.5, 0.9] {
+        let p = liggghts(y, nu, e_req, 0.0, 1.0);
+        let e_star = y / (2.0 * (1.0 - nu * nu));
+        for v in [0.1, 1.0, 5.0] {
+            let b = two_spheres(v);
+            let tc = hertz_tc(b[0].m / 2.0, 0.5e-3, e_star, v);
+            let (_, e, _) = impact(&LiggghtsHertz, &LiggghtsHistory, p, b, false, tc / 200.0);
+            assert!(((e - e_req) / e_req).abs() < 0.005, "hertz e={e_req} v={v}: {e}");
+            // hooke: kn from characteristicVelocity; e independent of v
+            let b = two_spheres(v);
+            let ms = b[0].m / 2.0;
+            let kn = demx::physics::normal::hooke::liggghts_hooke_kn(p.y_eff, 0.5e-3, ms, 1.0);
+            let (t, e, _) = impact(&LiggghtsHooke::default(), &LiggghtsHistory, p, b, false, PI * (ms / kn).sqrt() / 200.0);
+            assert!(((e - e_req) / e_req).abs() < 0.005, "hooke e={e_req} v={v}: {e}");
+            // damped oscillator: t_c = pi / sqrt(kn/m* - (gamma_n/(2 m*))^2), gamma_n from ln e
+            let le = e_req.ln();
+            let gamma = (4.0 * ms * kn * le * le / (le * le + PI * PI)).sqrt();
+            let tc = PI / (kn / ms - (gamma / (2.0 * ms)).powi(2)).sqrt();
+            assert!(((t - tc) / tc).abs() < 0.01, "hooke tc e={e_req} v={v}: {t} vs {tc}");
+        }
+    }
+}
+
+#[test]
+fn lammps_hooke_restitution_formula() {
+    // pair_style gran/hooke/history kn kt gamma_n gamma_t ...: F = kn delta - m* gamma_n vn,
+    // e = exp(-pi gamma_n / sqrt(4 kn/m* - gamma_n^2))
+    let b = two_spheres(1.0);
+    let ms = b[0].m / 2.0;
+    let kn = 2e5 * b[0].m * 9.81 / 2e-3; // Silbert: kn = 2e5 m g / d
+    let gamma_n = 50.0 * (9.81f64 / 2e-3).sqrt();
+    let p = lammps_gran_params(kn, None, gamma_n, None, 0.5, true, false);
+    let omega = (kn / ms - (gamma_n / 2.0).powi(2)).sqrt();
+    let tc = PI / omega;
+    let (t, e, _) = impact(&LammpsGranHooke, &LammpsGranHistory, p, b, false, tc / 200.0);
+    let e_expected = (-PI * gamma_n / (4.0 * kn / ms - gamma_n * gamma_n).sqrt()).exp();
+    assert!(((e - e_expected) / e_expected).abs() < 0.005, "{e} vs {e_expected}");
+    assert!(((t - tc) / tc).abs() < 0.01, "{t} vs {tc}");
+}
+
+#[test]
+fn elastic_impact_conserves_energy_and_momentum() {
+    let p = liggghts(7e10, 0.25, 1.0, 0.0, 1.0);
+    let (r1, r2) = (1e-3, 1.5e-3);
+    let v = 2.0;
+    let b = vec![
+        Body::sphere(r1, V3::new(0.0, 0.0, r1), V3::new(0.0, 0.0, -v)),
+        Body::sphere(r2, V3::new(0.0, 0.0, -r2), V3::new(0.0, 0.0, 0.3 * v)),
+    ];
+    let ke = |b: &[Body]| b.iter().map(|x| 0.5 * x.m * x.v.norm_squared()).sum::<f64>();
+    let mom = |b: &[Body]| b.iter().map(|x| x.v * x.m).sum::<V3>();
+    let (ke0, p0) = (ke(&b), mom(&b));
+    let ms = m_eff(b[0].m, b[1].m);
+    let tc = hertz_tc(ms, r_eff(r1, r2), 7e10 / (2.0 * (1.0 - 0.0625)), 1.3 * v);
+    let (_, _, b1) = impact(&LiggghtsHertz, &LiggghtsHistory, p, b, false, tc / 200.0);
+    assert!(((ke(&b1) - ke0) / ke0).abs() < 1e-6, "energy {} vs {}", ke(&b1), ke0);
+    assert!((mom(&b1) - p0).norm() / p0.norm() < 1e-12);
+}
+
+/// A sphere launched without spin along a wall under gravity: it slides with
+/// deceleration mu g until it rolls at v0 / (1 + I / (m l^2)), l the lever arm
+/// (5/7 v0 for l = R; the tight tolerance tells R from R - delta/2).
+fn sliding<T: TangentialLaw>(t: &T, lever_is_reduced: bool) {
+    let (mu, g, v0) = (0.3, 9.81, 1.0);
+    let p = liggghts(1e7, 0.3, 0.5, mu, 1.0);
+    let r = 1e-3;
+    let mut b = Body::sphere(r, V3::zeros(), V3::new(v0, 0.0, 0.0));
+    // static overlap under gravity: 4/3 E* sqrt(R) delta^1.5 = m g
+    let e_star = p.y_eff;
+    let delta0 = (b.m * g / (4.0 / 3.0 * e_star * r.sqrt())).powf(2.0 / 3.0);
+    b.x.z = r - delta0;
+    let dt = 1e-5;
+    let mut s = Sim::new(&LiggghtsHertz, t, p, vec![b], true, dt, g);
+    let t_slide = 2.0 / 7.0 * v0 / (mu * g);
+    let n1 = (0.2 * t_slide / dt) as usize;
+    let n2 = (0.8 * t_slide / dt) as usize;
+    for _ in 0..n1 {
+        s.step();
+    }
+    let v1 = s.b[0].v.x;
+    for _ in n1..n2 {
+        s.step();
+        // while sliding the friction force is at the Coulomb limit
+        assert!((s.ft_last.norm() - mu * s.fn_last.abs()).abs() <= 0.02 * mu * s.fn_last.abs());
+    }
+    let v2 = s.b[0].v.x;
+    let decel = (v1 - v2) / ((n2 - n1) as f64 * dt);
+    assert!(((decel - mu * g) / (mu * g)).abs() < 0.01, "deceleration {decel}");
+    for _ in n2..(3 * n2) {
+        s.step();
+    }
+    let l = if lever_is_reduced { r - 0.5 * delta0 } else { r };
+    let v_roll = v0 / (1.0 + s.b[0].inertia / (s.b[0].m * l * l));
+    assert!(((s.b[0].v.x - v_roll) / v_roll).abs() < 2e-5, "rolling {} vs {v_roll}", s.b[0].v.x);
+    // rolling without slip at the contact point
+    assert!((s.b[0].v.x - s.b[0].w.y * l).abs() < 0.01 * v_roll);
+}
+
+#[test]
+fn sliding_sphere_reaches_coulomb_limit_and_rolls_liggghts() {
+    sliding(&LiggghtsHistory, true);
+}
+
+#[test]
+fn sliding_sphere_reaches_coulomb_limit_and_rolls_lammps() {
+    sliding(&LammpsGranHistory, false);
+}
