@@ -208,7 +208,7 @@ fn truncated_last_frame_keeps_complete_frames() {
     let start4 = text.match_indices("ITEM: TIMESTEP").nth(3).unwrap().0;
     let atoms4 = start4 + text[start4..].find("ITEM: ATOMS").unwrap();
     let line_ends: Vec<usize> = text[atoms4..].match_indices('\n').map(|(i, _)| atoms4 + i + 1).collect();
-    for (cut, what) in [(line_ends[2], "2 of 6 atom lines"), (line_ends[3] - 7, "2 of 6 atom lines present, the next one is cut"), (start4 + 20, "file ends before")] {
+    for (cut, what) in [(line_ends[2], "2 of 6 atom lines"), (line_ends[3] - 7, "2 of 6 atom lines present, the next one is cut"), (start4 + 20, "file ends in the middle of a line")] {
         let f = dir.path().join("cut.dump");
         std::fs::write(&f, &text[..cut]).unwrap();
         let mut r = DumpReader::open(&f).unwrap();

@@ -294,9 +294,14 @@ impl DumpReader {
     fn need(&mut self, ts: Option<u64>, what: &str) -> std::result::Result<String, ReadErr> {
         match self.line()? {
             Some(l) if l.ends_with('\u{0}') => {
-                // Unterminated last line: usable only if it is complete data;
-                // callers re-check. Strip the marker.
-                Ok(l.trim_end_matches('\u{0}').to_string())
+                // Unterminated last line: the frame cannot be complete, except
+                // for a frame of zero atoms ending in its ATOMS line.
+                let l = l.trim_end_matches('\u{0}').to_string();
+                if l.starts_with("ITEM: ATOMS") {
+                    Ok(l)
+                } else {
+                    Err(self.cut(ts, "the file ends in the middle of a line"))
+                }
             }
             Some(l) => Ok(l),
             None => Err(self.cut(ts, &format!("file ends before {what}"))),
