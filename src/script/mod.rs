@@ -109,6 +109,11 @@ pub trait EvalContext {
     fn atom_vector(&self, keyword: &str) -> std::result::Result<Vec<f64>, String> {
         Err(format!("per-atom value {keyword} is not available here"))
     }
+    /// First and last step of the current run (`run N start S stop E` bounds),
+    /// for `ramp()`, `vdisplace()`, `swiggle()`, `cwiggle()`. `None` outside a run.
+    fn run_bounds(&self) -> Option<(i64, i64)> {
+        None
+    }
     /// Per-atom vector of a compute or fix (`c_ID`, `c_ID[i]`, `f_ID[i]`).
     fn peratom(&self, prefix: char, id: &str, _col: Option<usize>) -> std::result::Result<Vec<f64>, String> {
         Err(format!("per-atom {prefix}_{id} is not available here"))
