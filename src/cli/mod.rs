@@ -22,9 +22,12 @@ pub struct Cli {
 pub struct DeckArgs {
     /// The deck (input script).
     pub deck: PathBuf,
-    /// `-var NAME VALUE ...` (also `-v`), as LAMMPS takes them.
-    #[arg(long = "var", short = 'v', num_args = 2.., value_names = ["NAME", "VALUE"], action = clap::ArgAction::Append, allow_hyphen_values = true)]
-    pub var: Vec<Vec<String>>,
+    /// `-var NAME VALUE ...` (also `-v`), as LAMMPS takes them; may repeat.
+    #[arg(long = "var", short = 'v', num_args = 2.., value_names = ["NAME", "VALUE"], allow_hyphen_values = true)]
+    pub var: Vec<String>,
+    /// Grouped `-var` values (filled from the raw arguments).
+    #[arg(skip)]
+    pub var_groups: Vec<Vec<String>>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -86,7 +89,31 @@ enum DumpCmd {
 }
 
 fn cli_vars(d: &DeckArgs) -> Vec<(String, Vec<String>)> {
-    d.var.iter().filter(|v| !v.is_empty()).map(|v| (v[0].clone(), v[1..].to_vec())).collect()
+    d.var_groups.iter().filter(|v| !v.is_empty()).map(|v| (v[0].clone(), v[1..].to_vec())).collect()
+}
+
+/// Pull every `-var NAME V1 V2 ...` / `-v ...` group out of the raw
+/// arguments (values run until the next word starting with '-' that is not a
+/// number), as LAMMPS parses them.
+fn extract_vars(args: Vec<String>) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut rest = vec![];
+    let mut groups = vec![];
+    let mut k = 0;
+    while k < args.len() {
+        if k > 0 && matches!(args[k].as_str(), "-var" | "-v" | "--var") {
+            let mut g = vec![];
+            k += 1;
+            while k < args.len() && (g.is_empty() || !args[k].starts_with('-') || args[k].parse::<f64>().is_ok()) {
+                g.push(args[k].clone());
+                k += 1;
+            }
+            groups.push(g);
+        } else {
+            rest.push(args[k].clone());
+            k += 1;
+        }
+    }
+    (rest, groups)
 }
 
 /// Translate LAMMPS-style single-dash options (`-var`, `-v`, `-log`, `-in`)
@@ -131,7 +158,8 @@ fn report(err: &Error, sources: &SourceMap) -> ExitCode {
 
 /// Entry point.
 pub fn main() -> ExitCode {
-    let args = normalise_args(std::env::args().collect());
+    let (args, groups) = extract_vars(std::env::args().collect());
+    let args = normalise_args(args);
     let cli = match Cli::try_parse_from(args) {
         Ok(c) => c,
         Err(e) => {
@@ -141,7 +169,8 @@ pub fn main() -> ExitCode {
         }
     };
     match cli.cmd {
-        Cmd::Run { deck, threads, log, quiet } => {
+        Cmd::Run { mut deck, threads, log, quiet } => {
+            deck.var_groups = groups.clone();
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build_global();
             if pool.is_err() {
                 eprintln!("warning: thread pool already initialised");
@@ -152,7 +181,8 @@ pub fn main() -> ExitCode {
                 Err(e) => report(&e, &sources),
             }
         }
-        Cmd::Check { deck, json } => {
+        Cmd::Check { mut deck, json } => {
+            deck.var_groups = groups.clone();
             let (s, sources, r) = run_deck(&deck, true, 1, None, true);
             match r {
                 Ok(()) => {

@@ -11,6 +11,8 @@ pub mod setup;
 pub mod outputs;
 pub mod summary;
 pub mod walls;
+pub mod insert;
+pub mod mesh;
 
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{did_you_mean, Error, Result};

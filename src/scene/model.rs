@@ -570,9 +570,8 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                             return Err(Error::deck(span, format!("youngsModulus {} > 1e9 needs `hard_particles yes` (as in LIGGGHTS)", yi.max(yj)))
                                 .with_hint("add `hard_particles yes` before the pair_style"));
                         }
-                        let m = crate::physics::mixing::liggghts_moduli(yi, ni, yj, nj);
-                        p.y_eff = m.0;
-                        p.g_eff = m.1;
+                        p.y_eff = crate::physics::mixing::liggghts_y_eff(yi, ni, yj, nj);
+                        p.g_eff = crate::physics::mixing::liggghts_g_eff(yi, ni, yj, nj);
                     }
                     if let Some(e) = e {
                         let ev = per_pair("coefficientRestitution", e, i, j)?;

@@ -320,9 +320,6 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     }
     if style.text == "single" && single_units_lattice {
         let sp = lattice_spacing(s);
-        if s.lattice.is_none() {
-            return Err(Error::deck(cmd.span, "create_atoms single with units lattice needs a lattice").with_hint("add `units box`"));
-        }
         points[0] = points[0].component_mul(&sp);
     }
     if style.text == "box" || style.text == "region" {
@@ -331,7 +328,7 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         let filter = region_filter.clone();
         let f = move |p: V3| filter.as_ref().map_or(true, |r| r.contains(p));
         let pts = lat
-            .create_points(V3::from(dom.lo), V3::from(dom.hi), periodic, dom.dimension as usize, Some(&f))
+            .create_points(V3::from(dom.lo), V3::from(dom.hi), periodic, Some(&f))
             .map_err(|e| Error::deck(style.span, e.message()))?;
         points = pts.into_iter().map(|(p, _)| p).collect();
     }
@@ -630,12 +627,10 @@ fn delete_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
 
 /// Fixes that need geometry or insertion machinery.
 pub fn extended_fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
-    let _ = (cmd, id, group, a, vars);
+    
     match style.text.as_str() {
-        "wall/gran" => super::walls::wall_gran(s, cmd, id, group, style, a),
-        _ => {
-            s.need_box(cmd).ok();
-            Err(Error::unsupported(style.span, format!("fix {}", style.text)))
-        }
+        "wall/gran" if !a.rest().iter().any(|w| w.text == "mesh") => super::walls::wall_gran(s, cmd, id, group, style, a),
+        "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" => super::mesh::fix(s, cmd, id, group, style, a, vars),
+        _ => super::insert::fix(s, cmd, id, group, style, a, vars),
     }
 }
