@@ -354,3 +354,22 @@ fn sliding_sphere_reaches_coulomb_limit_and_rolls_liggghts() {
 fn sliding_sphere_reaches_coulomb_limit_and_rolls_lammps() {
     sliding(&LammpsGranHistory, false);
 }
+
+/// The run `liggghts` 3.8 makes (model hertz, tangential history, wall/gran
+/// zplane, Y = 1e7, nu = 0.3, e = 0.5, mu = 0.3, R = 1 mm, rho = 2500,
+/// gravity 981 m/s^2, start at the static overlap with vx = 1, dt = 1e-6,
+/// 8000 steps) ends rolling at vx = 0.711714016194768: the lever arm
+/// R - delta/2 (delta = 12.5 um), not 5/7.
+#[test]
+fn sliding_matches_liggghts_run() {
+    let (g, r) = (981.0, 1e-3);
+    let p = liggghts(1e7, 0.3, 0.5, 0.3, 1.0);
+    let mut b = Body::sphere(r, V3::zeros(), V3::new(1.0, 0.0, 0.0));
+    let delta0 = (b.m * g / (4.0 / 3.0 * p.y_eff * r.sqrt())).powf(2.0 / 3.0);
+    b.x.z = r - delta0;
+    let mut s = Sim::new(&LiggghtsHertz, &LiggghtsHistory, p, vec![b], true, 1e-6, g);
+    for _ in 0..8000 {
+        s.step();
+    }
+    assert!((s.b[0].v.x - 0.711714016194768).abs() < 1e-7, "{}", s.b[0].v.x);
+}

@@ -374,8 +374,8 @@ fn lammps_granular_history_rotation_and_rescale() {
     assert!(rel(h[0], 5e-6) < 1e-12);
     assert!(h[2].abs() < 1e-20);
     assert!(rel(out.ft.x, -1000.0 * 5e-6) < 1e-12);
-    // torque lever R - delta/2
-    assert!(rel(out.torque_i.y, (R - 0.5e-5) * 1000.0 * 5e-6) < 1e-12);
+    // fix wall/gran granular: torque lever R (lmp 2021)
+    assert!(rel(out.torque_i.y, R * 1000.0 * 5e-6) < 1e-12);
     // mindlin_rescale: a shrinks from 2e-4 to 1e-4 -> history halves; k_t = kt a
     let mut h = [2e-6, 0.0, 0.0, 2e-4];
     let mut out = normal_out(1.0, 0.0, 0.0);
@@ -568,4 +568,49 @@ fn lammps_sds_rolling_and_twisting() {
     LammpsSds { twisting: true }.rolling(&ct, &p, &mut h, &mut out);
     let m = -300.0 * w * dt - 0.1 * w;
     assert!(rel(out.torque_i.z, -0.05f64.min(-m)) < 1e-12);
+}
+
+#[test]
+fn torque_levers_match_the_engines() {
+    // lmp 29 Sep 2021 and liggghts 3.8, `run 0`: sphere 1 (R = 1 mm, z = 0.9 mm,
+    // vx = 0.5) on sphere 2 (R = 1.5 mm, z = -1.5 mm), delta = 0.1 mm,
+    // tangential force 5e-4 N: torques 4.75e-7 (i) and 7.25e-7 (j) N m in both
+    // `pair_style granular ... linear_nohistory` and LIGGGHTS `no_history`;
+    // LAMMPS `gran/hooke/history` uses the full radii.
+    let (r1, r2, delta) = (1e-3, 1.5e-3, 1e-4);
+    let n = V3::new(0.0, 0.0, 1.0);
+    let vr = V3::new(0.5, 0.0, 0.0);
+    let c = Contact {
+        n,
+        r: r1 + r2 - delta,
+        delta,
+        ri: r1,
+        rj: r2,
+        r_eff: r1 * r2 / (r1 + r2),
+        mi: M,
+        mj: M * 3.375,
+        m_eff: M * 3.375 / 4.375,
+        vr,
+        vn: 0.0,
+        wi: V3::zeros(),
+        wj: V3::zeros(),
+        dt: 1e-7,
+    };
+    let mut p = PairParams::default();
+    p.mu = 0.5;
+    p.gamma_t = 1.0;
+    let mut out = normal_out(0.1, 0.0, 0.0);
+    out.gamma_n = 1e-3;
+    LammpsLinearNoHistory.tangential(&c, &p, &mut [], &mut out);
+    assert!(rel(out.ft.x, -5e-4) < 1e-12);
+    assert!(rel(out.torque_i.y, 4.75e-7) < 1e-9);
+    assert!(rel(out.torque_j.y, 7.25e-7) < 1e-9);
+    let mut out = normal_out(0.1, 0.0, 1e-3);
+    LiggghtsNoHistory.tangential(&c, &p, &mut [], &mut out);
+    assert!(rel(out.torque_i.y, 4.75e-7) < 1e-9);
+    assert!(rel(out.torque_j.y, 7.25e-7) < 1e-9);
+    let mut out = normal_out(0.1, 0.0, 1e-3);
+    LammpsGranNoHistory.tangential(&c, &p, &mut [], &mut out);
+    assert!(rel(out.torque_i.y, 5e-7) < 1e-9);
+    assert!(rel(out.torque_j.y, 7.5e-7) < 1e-9);
 }
