@@ -373,3 +373,37 @@ fn sliding_matches_liggghts_run() {
     }
     assert!((s.b[0].v.x - 0.711714016194768).abs() < 1e-7, "{}", s.b[0].v.x);
 }
+
+/// LAMMPS `pair_style granular` restitution measured with `lmp` (29 Sep 2021,
+/// docs in shared/physics/engines.md): hertz/material E = 5e6, nu = 0.45,
+/// d = 2 mm, `damping tsuji` with e = 0.3/0.5/0.9 gives e_eff =
+/// 0.440/0.616/0.928 (the alpha(e) fit under-damps).
+#[test]
+fn lammps_tsuji_restitution_matches_lmp() {
+    use demx::physics::normal::granular::{GranularDamping, GranularNormal, LammpsGranular};
+    use demx::physics::tangential::granular::LammpsLinearNoHistory;
+    let law = LammpsGranular { model: GranularNormal::HertzMaterial, damping: GranularDamping::Tsuji };
+    for (e_in, e_lmp) in [(0.3, 0.440), (0.5, 0.616), (0.9, 0.928)] {
+        let gc = GranularCoeff {
+            normal: GranularNormal::HertzMaterial,
+            damping: GranularDamping::Tsuji,
+            kn_or_e: 5e6,
+            damp: e_in,
+            poisson: 0.45,
+            tangential: GranularTangentialChoice::NoHistory,
+            kt: Some(0.0),
+            x_gamma_t: 0.0,
+            mu: 0.0,
+            rolling: None,
+            twisting: None,
+            limit_damping: false,
+        };
+        let p = lammps_granular_params(&gc, false, span()).unwrap();
+        for v in [0.2, 2.0] {
+            let b = two_spheres(v);
+            let tc = hertz_tc(b[0].m / 2.0, 0.5e-3, p.y_eff, v);
+            let (_, e, _) = impact(&law, &LammpsLinearNoHistory, p, b, false, tc / 400.0);
+            assert!((e - e_lmp).abs() < 0.0015, "e_in={e_in} v={v}: {e} vs lmp {e_lmp}");
+        }
+    }
+}
