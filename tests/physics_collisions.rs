@@ -354,3 +354,56 @@ fn sliding_sphere_reaches_coulomb_limit_and_rolls_liggghts() {
 fn sliding_sphere_reaches_coulomb_limit_and_rolls_lammps() {
     sliding(&LammpsGranHistory, false);
 }
+
+/// The run `liggghts` 3.8 makes (model hertz, tangential history, wall/gran
+/// zplane, Y = 1e7, nu = 0.3, e = 0.5, mu = 0.3, R = 1 mm, rho = 2500,
+/// gravity 981 m/s^2, start at the static overlap with vx = 1, dt = 1e-6,
+/// 8000 steps) ends rolling at vx = 0.711714016194768: the lever arm
+/// R - delta/2 (delta = 12.5 um), not 5/7.
+#[test]
+fn sliding_matches_liggghts_run() {
+    let (g, r) = (981.0, 1e-3);
+    let p = liggghts(1e7, 0.3, 0.5, 0.3, 1.0);
+    let mut b = Body::sphere(r, V3::zeros(), V3::new(1.0, 0.0, 0.0));
+    let delta0 = (b.m * g / (4.0 / 3.0 * p.y_eff * r.sqrt())).powf(2.0 / 3.0);
+    b.x.z = r - delta0;
+    let mut s = Sim::new(&LiggghtsHertz, &LiggghtsHistory, p, vec![b], true, 1e-6, g);
+    for _ in 0..8000 {
+        s.step();
+    }
+    assert!((s.b[0].v.x - 0.711714016194768).abs() < 1e-7, "{}", s.b[0].v.x);
+}
+
+/// LAMMPS `pair_style granular` restitution measured with `lmp` (29 Sep 2021,
+/// docs in shared/physics/engines.md): hertz/material E = 5e6, nu = 0.45,
+/// d = 2 mm, `damping tsuji` with e = 0.3/0.5/0.9 gives e_eff =
+/// 0.440/0.616/0.928 (the alpha(e) fit under-damps).
+#[test]
+fn lammps_tsuji_restitution_matches_lmp() {
+    use demx::physics::normal::granular::{GranularDamping, GranularNormal, LammpsGranular};
+    use demx::physics::tangential::granular::LammpsLinearNoHistory;
+    let law = LammpsGranular { model: GranularNormal::HertzMaterial, damping: GranularDamping::Tsuji };
+    for (e_in, e_lmp) in [(0.3, 0.440), (0.5, 0.616), (0.9, 0.928)] {
+        let gc = GranularCoeff {
+            normal: GranularNormal::HertzMaterial,
+            damping: GranularDamping::Tsuji,
+            kn_or_e: 5e6,
+            damp: e_in,
+            poisson: 0.45,
+            tangential: GranularTangentialChoice::NoHistory,
+            kt: Some(0.0),
+            x_gamma_t: 0.0,
+            mu: 0.0,
+            rolling: None,
+            twisting: None,
+            limit_damping: false,
+        };
+        let p = lammps_granular_params(&gc, false, span()).unwrap();
+        for v in [0.2, 2.0] {
+            let b = two_spheres(v);
+            let tc = hertz_tc(b[0].m / 2.0, 0.5e-3, p.y_eff, v);
+            let (_, e, _) = impact(&law, &LammpsLinearNoHistory, p, b, false, tc / 400.0);
+            assert!((e - e_lmp).abs() < 0.0015, "e_in={e_in} v={v}: {e} vs lmp {e_lmp}");
+        }
+    }
+}

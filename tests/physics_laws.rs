@@ -374,8 +374,8 @@ fn lammps_granular_history_rotation_and_rescale() {
     assert!(rel(h[0], 5e-6) < 1e-12);
     assert!(h[2].abs() < 1e-20);
     assert!(rel(out.ft.x, -1000.0 * 5e-6) < 1e-12);
-    // torque lever R - delta/2
-    assert!(rel(out.torque_i.y, (R - 0.5e-5) * 1000.0 * 5e-6) < 1e-12);
+    // fix wall/gran granular: torque lever R (lmp 2021)
+    assert!(rel(out.torque_i.y, R * 1000.0 * 5e-6) < 1e-12);
     // mindlin_rescale: a shrinks from 2e-4 to 1e-4 -> history halves; k_t = kt a
     let mut h = [2e-6, 0.0, 0.0, 2e-4];
     let mut out = normal_out(1.0, 0.0, 0.0);
@@ -422,4 +422,195 @@ fn lammps_granular_mix_2021_is_geometric() {
     let m = lammps_granular_mix_2021(&a, &b);
     // lmp 29 Sep 2021, types 1-2 without pair_coeff, delta = 1e-4: F = 1443.55189856205 N
     assert!(rel(m.kn * 1e-4, 1443.55189856205) < 1e-12);
+}
+
+use demx::physics::cohesion::sjkr::LiggghtsSjkr;
+use demx::physics::cohesion::sjkr2::LiggghtsSjkr2;
+use demx::physics::rolling::cdt::LiggghtsCdt;
+use demx::physics::rolling::epsd::LiggghtsEpsd;
+use demx::physics::rolling::epsd2::LiggghtsEpsd2;
+use demx::physics::rolling::epsd3::LiggghtsEpsd3;
+use demx::physics::rolling::sds::LammpsSds;
+
+#[test]
+fn sjkr_areas_and_tangential_reduce() {
+    let mut p = PairParams::default();
+    p.cohesion = 3e5;
+    let delta = 1e-5;
+    let d = 2.0 * R - delta;
+    let c = pair(delta, V3::zeros(), V3::zeros(), V3::zeros(), 1e-7);
+    let mut out = normal_out(1.0, 0.0, 0.0);
+    LiggghtsSjkr { tangential_reduce: false }.cohesion(&c, &p, &mut [], &mut out);
+    // intersection circle of two equal spheres: a^2 = R^2 - d^2/4
+    let f = -3e5 * std::f64::consts::PI * (R * R - d * d / 4.0);
+    assert!(rel(out.fn_coh, f) < 1e-9);
+    assert_eq!(out.fn_for_friction, 1.0);
+    let mut out = normal_out(1.0, 0.0, 0.0);
+    LiggghtsSjkr { tangential_reduce: true }.cohesion(&c, &p, &mut [], &mut out);
+    assert!(rel(out.fn_for_friction, 1.0 + f) < 1e-12);
+    let cw = wall(delta, V3::zeros(), V3::zeros(), 1e-7);
+    let mut out = ContactOut::default();
+    LiggghtsSjkr::default().cohesion(&cw, &p, &mut [], &mut out);
+    let dw = R - delta;
+    assert!(rel(out.fn_coh, -3e5 * std::f64::consts::PI * (R * R - dw * dw)) < 1e-9);
+    let mut out = ContactOut::default();
+    LiggghtsSjkr2::default().cohesion(&c, &p, &mut [], &mut out);
+    assert!(rel(out.fn_coh, -3e5 * 2.0 * std::f64::consts::PI * R * delta) < 1e-12);
+    let mut out = ContactOut::default();
+    LiggghtsSjkr2::default().cohesion(&cw, &p, &mut [], &mut out);
+    assert!(rel(out.fn_coh, -3e5 * 2.0 * std::f64::consts::PI * R * delta) < 1e-12);
+}
+
+#[test]
+fn epsd_family_spring_dashpot_cap_and_signs() {
+    let mut p = PairParams::default();
+    p.mu_r = 0.1;
+    p.eta_r = 0.3;
+    p.k_r_coeff = 4.0;
+    let dt = 1e-6;
+    let w = 2.0;
+    // pair: i spins about +x, j at rest; n = +z
+    let c = pair(1e-5, V3::zeros(), V3::new(w, 0.0, 0.0), V3::zeros(), dt);
+    let (kn, kt) = (1000.0, 800.0);
+    let rs = R / 2.0;
+    let mut out = normal_out(1.0, kt, 0.0);
+    out.kn = kn;
+    let mut h = [0.0; 3];
+    LiggghtsEpsd::default().rolling(&c, &p, &mut h, &mut out);
+    let k_r = 2.25 * kn * 0.01 * rs * rs;
+    let i_r = 1.4 * (M * R * R) * (M * R * R) / (2.0 * M * R * R);
+    let m = k_r * w * dt + 0.3 * 2.0 * (i_r * k_r).sqrt() * w;
+    assert!(rel(h[0], k_r * w * dt) < 1e-12);
+    assert!(rel(out.torque_i.x, -m) < 1e-12);
+    assert!(rel(out.torque_j.x, m) < 1e-12);
+    // at the cap: |M| = mu_r R* |Fn|, stored capped, no dashpot
+    let mut h = [1.0, 0.0, 0.0];
+    let mut out = normal_out(-2.0, kt, 0.0);
+    out.kn = kn;
+    LiggghtsEpsd::default().rolling(&c, &p, &mut h, &mut out);
+    assert!(rel(out.torque_i.x, -0.1 * rs * 2.0) < 1e-12);
+    assert!(rel(h[0], 0.1 * rs * 2.0) < 1e-12);
+    // twisting about n is ignored unless torsionTorque
+    let ct = pair(1e-5, V3::zeros(), V3::new(0.0, 0.0, w), V3::zeros(), dt);
+    let mut h = [0.0; 3];
+    let mut out = normal_out(1.0, kt, 0.0);
+    out.kn = kn;
+    LiggghtsEpsd::default().rolling(&ct, &p, &mut h, &mut out);
+    assert_eq!(out.torque_i, V3::zeros());
+    LiggghtsEpsd { torsion_torque: true }.rolling(&ct, &p, &mut h, &mut out);
+    assert!(out.torque_i.z < 0.0);
+    // epsd2: k_r = kt R*^2, no dashpot
+    let mut h = [0.0; 3];
+    let mut out = normal_out(1.0, kt, 0.0);
+    LiggghtsEpsd2::default().rolling(&c, &p, &mut h, &mut out);
+    assert!(rel(out.torque_i.x, -kt * rs * rs * w * dt) < 1e-12);
+    // epsd3: coeffRollingStiffness replaces 2.25
+    let mut h = [0.0; 3];
+    let mut out = normal_out(1.0, kt, 0.0);
+    out.kn = kn;
+    LiggghtsEpsd3::default().rolling(&c, &p, &mut h, &mut out);
+    let k_r3 = 4.0 * kn * 0.01 * rs * rs;
+    assert!(rel(h[0], k_r3 * w * dt) < 1e-12);
+    assert!(rel(out.torque_i.x, -(k_r3 * w * dt + 0.3 * 2.0 * (i_r * k_r3).sqrt() * w)) < 1e-12);
+}
+
+#[test]
+fn cdt_constant_torque() {
+    let mut p = PairParams::default();
+    p.mu_r = 0.1;
+    let c = pair(1e-5, V3::zeros(), V3::new(0.0, 3.0, 0.0), V3::new(0.0, -1.0, 0.0), 1e-6);
+    let mut out = ContactOut::default();
+    out.kn = 1000.0;
+    LiggghtsCdt.rolling(&c, &p, &mut [], &mut out);
+    let m = 0.1 * 1000.0 * 1e-5 * R / 2.0;
+    assert!(rel(out.torque_i.y, -m) < 1e-12);
+    assert!(rel(out.torque_j.y, m) < 1e-12);
+    // wall: lever R - delta/2
+    let cw = wall(1e-5, V3::zeros(), V3::new(0.0, 3.0, 0.0), 1e-6);
+    let mut out = ContactOut::default();
+    out.kn = 1000.0;
+    LiggghtsCdt.rolling(&cw, &p, &mut [], &mut out);
+    assert!(rel(out.torque_i.y, -0.1 * 1000.0 * 1e-5 * (R - 0.5e-5)) < 1e-12);
+}
+
+#[test]
+fn lammps_sds_rolling_and_twisting() {
+    let mut p = PairParams::default();
+    p.k_roll = 500.0;
+    p.gamma_roll = 0.2;
+    p.mu_r = 0.1;
+    p.k_twist = 300.0;
+    p.gamma_twist = 0.1;
+    p.mu_twist = 0.05;
+    let dt = 1e-6;
+    let w = 2.0;
+    // sphere on a wall rolling about +y: v_roll = R w x n = R w (+x)
+    let c = wall(1e-5, V3::zeros(), V3::new(0.0, w, 0.0), dt);
+    let mut h = [0.0; 4];
+    let mut out = normal_out(1.0, 0.0, 0.0);
+    LammpsSds { twisting: true }.rolling(&c, &p, &mut h, &mut out);
+    let v = R * w;
+    assert!(rel(h[0], v * dt) < 1e-12);
+    let fr = -(500.0 * v * dt + 0.2 * v);
+    // torque R n x F_r: z x (fr x) = fr y, opposing the spin
+    assert!(rel(out.torque_i.y, R * fr) < 1e-12);
+    assert!(out.torque_i.y < 0.0);
+    // cap: large history -> |F_r| = mu_roll F_n, history consistent
+    let mut h = [1.0, 0.0, 0.0, 0.0];
+    let mut out = normal_out(1.0, 0.0, 0.0);
+    LammpsSds { twisting: false }.rolling(&c, &p, &mut h, &mut out);
+    assert!(rel(out.torque_i.y, -R * 0.1) < 1e-12);
+    assert!(rel(500.0 * h[0] + 0.2 * v, 0.1) < 1e-12);
+    // twisting about n: M = -k phi - gamma w_t, capped at mu_twist F_n
+    let ct = wall(1e-5, V3::zeros(), V3::new(0.0, 0.0, w), dt);
+    let mut h = [0.0; 4];
+    let mut out = normal_out(1.0, 0.0, 0.0);
+    LammpsSds { twisting: true }.rolling(&ct, &p, &mut h, &mut out);
+    let m = -300.0 * w * dt - 0.1 * w;
+    assert!(rel(out.torque_i.z, -0.05f64.min(-m)) < 1e-12);
+}
+
+#[test]
+fn torque_levers_match_the_engines() {
+    // lmp 29 Sep 2021 and liggghts 3.8, `run 0`: sphere 1 (R = 1 mm, z = 0.9 mm,
+    // vx = 0.5) on sphere 2 (R = 1.5 mm, z = -1.5 mm), delta = 0.1 mm,
+    // tangential force 5e-4 N: torques 4.75e-7 (i) and 7.25e-7 (j) N m in both
+    // `pair_style granular ... linear_nohistory` and LIGGGHTS `no_history`;
+    // LAMMPS `gran/hooke/history` uses the full radii.
+    let (r1, r2, delta) = (1e-3, 1.5e-3, 1e-4);
+    let n = V3::new(0.0, 0.0, 1.0);
+    let vr = V3::new(0.5, 0.0, 0.0);
+    let c = Contact {
+        n,
+        r: r1 + r2 - delta,
+        delta,
+        ri: r1,
+        rj: r2,
+        r_eff: r1 * r2 / (r1 + r2),
+        mi: M,
+        mj: M * 3.375,
+        m_eff: M * 3.375 / 4.375,
+        vr,
+        vn: 0.0,
+        wi: V3::zeros(),
+        wj: V3::zeros(),
+        dt: 1e-7,
+    };
+    let mut p = PairParams::default();
+    p.mu = 0.5;
+    p.gamma_t = 1.0;
+    let mut out = normal_out(0.1, 0.0, 0.0);
+    out.gamma_n = 1e-3;
+    LammpsLinearNoHistory.tangential(&c, &p, &mut [], &mut out);
+    assert!(rel(out.ft.x, -5e-4) < 1e-12);
+    assert!(rel(out.torque_i.y, 4.75e-7) < 1e-9);
+    assert!(rel(out.torque_j.y, 7.25e-7) < 1e-9);
+    let mut out = normal_out(0.1, 0.0, 1e-3);
+    LiggghtsNoHistory.tangential(&c, &p, &mut [], &mut out);
+    assert!(rel(out.torque_i.y, 4.75e-7) < 1e-9);
+    assert!(rel(out.torque_j.y, 7.25e-7) < 1e-9);
+    let mut out = normal_out(0.1, 0.0, 1e-3);
+    LammpsGranNoHistory.tangential(&c, &p, &mut [], &mut out);
+    assert!(rel(out.torque_i.y, 5e-7) < 1e-9);
+    assert!(rel(out.torque_j.y, 7.5e-7) < 1e-9);
 }

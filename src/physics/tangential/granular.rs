@@ -13,7 +13,7 @@
 //! k_t v_t dt (Thornton 2013 eq. 18); F_t = -k xi - eta_t v_t (force models
 //! xi - eta_t v_t); if |F_t| > mu F_ncrit, F_t is scaled to the cap and the
 //! history set consistently including the damping term. Relative velocity
-//! uses the full radii, torque the lever R - delta/2.
+//! uses the full radii, torque the lever R - delta/2 (pairs) or R (walls).
 
 use super::no_history::capped_viscous;
 use super::{add_tangential_torque, get3, put3, rel_tangential_velocity};
@@ -49,10 +49,18 @@ impl GranularTangential {
     }
 }
 
-/// The torque lever of LAMMPS granular: R - delta/2 (none for walls' j side).
+/// The torque lever of LAMMPS granular: R - delta/2 for particle pairs
+/// (`pair_style granular`), but the full radius R for `fix wall/gran
+/// granular` (both verified with the 29 Sep 2021 `lmp`: torque / tangential
+/// force = 0.95 mm and 1.45 mm for R = 1 and 1.5 mm at delta = 0.1 mm, and
+/// 1.0 mm against a wall).
 #[inline(always)]
 fn torque_levers(c: &Contact) -> (f64, f64) {
-    (c.ri - 0.5 * c.delta, c.rj - 0.5 * c.delta)
+    if c.is_wall() {
+        (c.ri, c.rj)
+    } else {
+        (c.ri - 0.5 * c.delta, c.rj - 0.5 * c.delta)
+    }
 }
 
 /// LAMMPS granular tangential laws with history. History: xi (3) and the
