@@ -3,3 +3,4 @@
 pub mod cfmt;
 pub mod data;
 pub mod dump;
+pub mod vtk;
