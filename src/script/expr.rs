@@ -329,6 +329,10 @@ impl<'a> Parser<'a> {
         // function call?
         if rest.starts_with('(') {
             self.pos += 1;
+            self.nodes += 20; // nesting costs stack: bound it harder than terms
+            if self.nodes > MAX_NODES {
+                return Err("variable formula is nested too deeply".into());
+            }
             if let Some(&(_, n)) = MATH.iter().find(|(f, _)| *f == word) {
                 let raw = self.args()?;
                 if raw.len() != n {

@@ -145,8 +145,9 @@ enum Val {
     V(Vec<f64>),
 }
 
-/// How deep variables may refer to variables before it is called circular.
-const MAX_DEPTH: usize = 64;
+/// How deep evaluation may recurse (formula nesting plus variables referring
+/// to variables) before it is called circular; keeps the stack bounded.
+const MAX_DEPTH: usize = 1500;
 
 fn valid_name(name: &str) -> bool {
     !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
@@ -376,6 +377,13 @@ impl Variables {
 
     /// The text `${name}` is replaced by. `Ok(None)` if the variable is not defined.
     pub fn retrieve(&self, name: &str, ctx: &dyn EvalContext) -> std::result::Result<Option<String>, String> {
+        self.retrieve_depth(name, ctx, 0)
+    }
+
+    fn retrieve_depth(&self, name: &str, ctx: &dyn EvalContext, depth: usize) -> std::result::Result<Option<String>, String> {
+        if depth > MAX_DEPTH {
+            return Err(format!("variable '{name}' has a circular dependency (or is nested too deeply)"));
+        }
         let Some(v) = self.vars.get(name) else { return Ok(None) };
         Ok(Some(match &v.data {
             Data::List { values, which } => values.get(*which).cloned().unwrap_or_default(),
@@ -383,13 +391,13 @@ impl Variables {
             Data::Str(s) => s.clone(),
             Data::Getenv(k) => std::env::var(k).unwrap_or_default(),
             Data::Format { var, fmt } => {
-                let x = self.eval_equal_depth(var, ctx, 1)?;
+                let x = self.eval_equal_depth(var, ctx, depth + 1)?;
                 cfmt::sprintf(fmt, &[cfmt::CArg::Float(x)])?
             }
             Data::Formula { .. } if v.style == VarStyle::Atom => {
                 return Err(format!("atom-style variable '{name}' cannot be substituted with $"));
             }
-            Data::Formula { .. } | Data::Internal(_) => cfmt::fmt_g(self.eval_equal_depth(name, ctx, 0)?, 15),
+            Data::Formula { .. } | Data::Internal(_) => cfmt::fmt_g(self.eval_equal_depth(name, ctx, depth + 1)?, 15),
         }))
     }
 
@@ -413,7 +421,7 @@ impl Variables {
 
     fn eval_equal_depth(&self, name: &str, ctx: &dyn EvalContext, depth: usize) -> std::result::Result<f64, String> {
         if depth > MAX_DEPTH {
-            return Err(format!("variable '{name}' has a circular dependency"));
+            return Err(format!("variable '{name}' has a circular dependency (or is nested too deeply)"));
         }
         let Some(v) = self.vars.get(name) else { return Err(self.undefined(name)) };
         match &v.data {
@@ -423,8 +431,9 @@ impl Variables {
             },
             Data::Formula { .. } => Err(format!("atom-style variable '{name}' used where a single number is needed")),
             Data::Internal(x) => Ok(*x),
+            Data::Format { var, .. } if var == name => Err(format!("format variable '{name}' formats itself (circular dependency)")),
             _ => {
-                let s = self.retrieve(name, ctx)?.unwrap_or_default();
+                let s = self.retrieve_depth(name, ctx, depth + 1)?.unwrap_or_default();
                 s.trim().parse::<f64>().map_err(|_| format!("variable '{name}' has the non-numeric value '{s}'"))
             }
         }
@@ -485,6 +494,10 @@ impl Variables {
     }
 
     fn eval(&self, e: &Expr, ctx: &dyn EvalContext, atom: bool, depth: usize) -> std::result::Result<Val, String> {
+        if depth > MAX_DEPTH {
+            return Err("variable formula nested too deeply (circular dependency between variables?)".into());
+        }
+        let depth = depth + 1;
         Ok(match e {
             Expr::Num(x) => Val::S(*x),
             Expr::Neg(a) => map1(self.eval(a, ctx, atom, depth)?, |x| Ok(-x))?,
