@@ -137,3 +137,13 @@ fn styles_and_errors() {
     define(&mut v, "variable f format f %g").unwrap();
     assert!(v.string_value("f", &Sim).is_err());
 }
+
+#[test]
+fn hosts_substitute_fix_print_text() {
+    let mut v = Variables::new();
+    define(&mut v, "variable h equal 0.25").unwrap();
+    let w = Word::new("step $(step) h=${h} $h", Span::DUMMY);
+    assert_eq!(v.substitute_word(&w, &Sim).unwrap(), "step 250 h=0.25 0.25");
+    let bad = Word::new("${nope}", Span::DUMMY);
+    assert_eq!(v.substitute_word(&bad, &Sim).unwrap_err().message(), "variable 'nope' is not defined");
+}

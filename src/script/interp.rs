@@ -16,7 +16,6 @@
 use super::lexer::{self, LogicalLine, RawWord, Reference, Text};
 use super::{Command, EvalContext, FileId, Host, SourceMap, Span, Variables, Word};
 use crate::error::{Error, Result};
-use crate::io::cfmt;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -520,24 +519,5 @@ impl Interpreter {
 
 /// The text a `$` reference stands for.
 fn resolve(vars: &Variables, r: &Reference, span: Span, ctx: &dyn EvalContext) -> Result<String> {
-    match r {
-        Reference::Var(name) => match vars.retrieve(name, ctx) {
-            Ok(Some(s)) => Ok(s),
-            Ok(None) => {
-                let e = Error::deck(span, format!("variable '{name}' is not defined"));
-                Ok(Err(match vars.suggest(name) {
-                    Some(h) => e.with_hint(h),
-                    None => e,
-                })?)
-            }
-            Err(m) => Err(Error::deck(span, m)),
-        },
-        Reference::Immediate(text, fmt) => {
-            let x = vars.eval_expr(text, ctx).map_err(|m| Error::deck(span, m))?;
-            match fmt {
-                None => Ok(cfmt::fmt_g(x, 20)),
-                Some(f) => cfmt::sprintf(f, &[cfmt::CArg::Float(x)]).map_err(|m| Error::deck(span, format!("invalid format '{f}' in immediate variable: {m}"))),
-            }
-        }
-    }
+    super::vars::resolve_reference(vars, r, span, ctx)
 }

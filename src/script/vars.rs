@@ -401,6 +401,15 @@ impl Variables {
         }))
     }
 
+    /// Substitute `$x`, `${name}` and `$(expr)` in text, as `print` and
+    /// `fix print` do when they run (quoted parts are left as they are).
+    /// Errors point at the word.
+    pub fn substitute_word(&self, w: &Word, ctx: &dyn EvalContext) -> Result<String> {
+        let t = super::lexer::Text::uniform(&w.text, w.span);
+        let (out, _) = super::lexer::substitute(&t, &mut |r, sp| resolve_reference(self, r, sp, ctx))?;
+        Ok(out.s)
+    }
+
     /// The value of a variable as text (what `${name}` gives).
     pub fn string_value(&self, name: &str, ctx: &dyn EvalContext) -> std::result::Result<String, String> {
         self.retrieve(name, ctx)?.ok_or_else(|| self.undefined(name))
@@ -613,6 +622,32 @@ impl Variables {
                 mapn(vals, |a| apply_step_fn(name, a, step, begin, end, dt))
             }
             _ => mapn(vals, |a| apply_math(name, a)),
+        }
+    }
+}
+
+/// The text a `$` reference stands for: `${v}` as [`Variables::retrieve`]
+/// gives it, `$(expr)` formatted `%.20g` or with its `:%fmt`.
+pub fn resolve_reference(vars: &Variables, r: &super::lexer::Reference, span: Span, ctx: &dyn EvalContext) -> Result<String> {
+    use super::lexer::Reference;
+    match r {
+        Reference::Var(name) => match vars.retrieve(name, ctx) {
+            Ok(Some(s)) => Ok(s),
+            Ok(None) => {
+                let e = Error::deck(span, format!("variable '{name}' is not defined"));
+                Err(match vars.suggest(name) {
+                    Some(h) => e.with_hint(h),
+                    None => e,
+                })
+            }
+            Err(m) => Err(Error::deck(span, m)),
+        },
+        Reference::Immediate(text, fmt) => {
+            let x = vars.eval_expr(text, ctx).map_err(|m| Error::deck(span, m))?;
+            match fmt {
+                None => Ok(cfmt::fmt_g(x, 20)),
+                Some(f) => cfmt::sprintf(f, &[cfmt::CArg::Float(x)]).map_err(|m| Error::deck(span, format!("invalid format '{f}' in immediate variable: {m}"))),
+            }
         }
     }
 }
