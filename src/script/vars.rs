@@ -114,7 +114,7 @@ impl Clone for Rng {
 impl Rng {
     /// Uniform in (0,1); seeded by `seed` on first use (as LAMMPS seeds once).
     fn uniform(&self, seed: f64) -> std::result::Result<f64, String> {
-        if !(seed >= 1.0) {
+        if seed.is_nan() || seed < 1.0 {
             return Err("invalid seed for random()/normal() in variable formula (must be > 0)".into());
         }
         let mut g = self.0.lock().map_err(|_| "random generator poisoned".to_string())?;
