@@ -172,6 +172,26 @@ fn mutate(rng: &mut XorShift, seeds: &[Vec<u8>], base: &[u8]) -> Vec<u8> {
     d
 }
 
+fn run_one(text: &str) -> Option<String> {
+    let mut it = Interpreter::new(SourceMap::new(), vec![("cli".into(), vec!["1".into(), "2".into()])]);
+    it.set_command_limit(300);
+    it.set_file_access(false);
+    let mut host = Accept { step: 0 };
+    match it.run_text("in.fuzz", text, &mut host) {
+        Ok(()) => None,
+        Err(e) => Some(e.render(&it.sources)),
+    }
+}
+
+/// `DEMX_FUZZ_REPLAY=path` runs one saved deck without catching panics.
+#[test]
+fn fuzz_replay() {
+    if let Ok(p) = std::env::var("DEMX_FUZZ_REPLAY") {
+        let text = demx::script::source::decode(&std::fs::read(p).unwrap());
+        eprintln!("{:?}", run_one(&text));
+    }
+}
+
 #[test]
 fn fuzz_interpreter_never_panics() {
     let cases: usize = std::env::var("DEMX_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(20000);
@@ -185,18 +205,11 @@ fn fuzz_interpreter_never_panics() {
         let base = &seeds[rng.below(seeds.len())];
         let deck = mutate(&mut rng, &seeds, base);
         let text = demx::script::source::decode(&deck);
-        let r = catch_unwind(AssertUnwindSafe(|| {
-            let mut it = Interpreter::new(SourceMap::new(), vec![("cli".into(), vec!["1".into(), "2".into()])]);
-            it.set_command_limit(300);
-            it.set_file_access(false);
-            let mut host = Accept { step: 0 };
-            match it.run_text("in.fuzz", &text, &mut host) {
-                Ok(()) => false,
-                Err(e) => {
-                    let r = e.render(&it.sources);
-                    assert!(!r.is_empty());
-                    true
-                }
+        let r = catch_unwind(AssertUnwindSafe(|| match run_one(&text) {
+            None => false,
+            Some(r) => {
+                assert!(!r.is_empty());
+                true
             }
         }));
         match r {
