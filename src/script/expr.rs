@@ -329,6 +329,10 @@ impl<'a> Parser<'a> {
         // function call?
         if rest.starts_with('(') {
             self.pos += 1;
+            self.nodes += 20; // nesting costs stack: bound it harder than terms
+            if self.nodes > MAX_NODES {
+                return Err("variable formula is nested too deeply".into());
+            }
             if let Some(&(_, n)) = MATH.iter().find(|(f, _)| *f == word) {
                 let raw = self.args()?;
                 if raw.len() != n {
@@ -434,15 +438,15 @@ pub fn eval_boolean(text: &str) -> Result<f64, String> {
             i += 1;
             continue;
         }
-        let two = if i + 1 < b.len() { &text[i..i + 2] } else { "" };
+        let two: &[u8] = b.get(i..i + 2).unwrap_or(b"");
         let op2 = match two {
-            "<=" => Some(BinOp::Le),
-            ">=" => Some(BinOp::Ge),
-            "==" => Some(BinOp::Eq),
-            "!=" => Some(BinOp::Ne),
-            "&&" => Some(BinOp::And),
-            "||" => Some(BinOp::Or),
-            "|^" => Some(BinOp::Xor),
+            b"<=" => Some(BinOp::Le),
+            b">=" => Some(BinOp::Ge),
+            b"==" => Some(BinOp::Eq),
+            b"!=" => Some(BinOp::Ne),
+            b"&&" => Some(BinOp::And),
+            b"||" => Some(BinOp::Or),
+            b"|^" => Some(BinOp::Xor),
             _ => None,
         };
         if let Some(op) = op2 {
@@ -780,5 +784,8 @@ mod tests {
         assert!(eval_boolean("a < b").is_err());
         assert!(eval_boolean("a b == a b").is_err());
         assert!(eval_boolean("1+1 == 2").is_err());
+        // found by the fuzz test: a multi-byte character after a digit
+        assert!(eval_boolean("2\u{e9} > 1").is_err());
+        assert_eq!(eval_boolean("\u{e9}t\u{e9} == \u{e9}t\u{e9}").unwrap(), 1.0);
     }
 }

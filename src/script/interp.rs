@@ -16,7 +16,6 @@
 use super::lexer::{self, LogicalLine, RawWord, Reference, Text};
 use super::{Command, EvalContext, FileId, Host, SourceMap, Span, Variables, Word};
 use crate::error::{Error, Result};
-use crate::io::cfmt;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -61,7 +60,7 @@ pub struct Interpreter {
     quit: bool,
     limit: Option<u64>,
     count: u64,
-    allow_file_output: bool,
+    file_access: bool,
 }
 
 impl Interpreter {
@@ -83,7 +82,7 @@ impl Interpreter {
             quit: false,
             limit: None,
             count: 0,
-            allow_file_output: true,
+            file_access: true,
         }
     }
 
@@ -98,9 +97,11 @@ impl Interpreter {
         self.echo = echo;
     }
 
-    /// Whether `print ... file/append` may write files (off for fuzzing).
-    pub fn set_file_output(&mut self, allow: bool) {
-        self.allow_file_output = allow;
+    /// Whether the deck may touch files: `print ... file/append` writes,
+    /// `include` and `jump FILE` reads (off for fuzzing: prints skip the
+    /// file, reads fail with an error).
+    pub fn set_file_access(&mut self, allow: bool) {
+        self.file_access = allow;
     }
 
     /// Number of lines and commands processed so far.
@@ -151,6 +152,9 @@ impl Interpreter {
     fn load(&mut self, path: &Path, span: Span) -> Result<FileId> {
         if let Some(&id) = self.files.get(path) {
             return Ok(id);
+        }
+        if !self.file_access && span.is_real() {
+            return Err(Error::deck(span, format!("cannot open input script '{}': file access is disabled", path.display())));
         }
         let id = self.sources.load(path).map_err(|e| Error::io(span, format!("cannot open input script '{}'", path.display()), &e))?;
         self.files.insert(path.to_path_buf(), id);
@@ -399,7 +403,7 @@ impl Interpreter {
             k += 2;
         }
         if let Some((f, append)) = file {
-            if self.allow_file_output {
+            if self.file_access {
                 use std::io::Write;
                 let mut opts = std::fs::OpenOptions::new();
                 if append {
@@ -515,24 +519,5 @@ impl Interpreter {
 
 /// The text a `$` reference stands for.
 fn resolve(vars: &Variables, r: &Reference, span: Span, ctx: &dyn EvalContext) -> Result<String> {
-    match r {
-        Reference::Var(name) => match vars.retrieve(name, ctx) {
-            Ok(Some(s)) => Ok(s),
-            Ok(None) => {
-                let e = Error::deck(span, format!("variable '{name}' is not defined"));
-                Ok(Err(match vars.suggest(name) {
-                    Some(h) => e.with_hint(h),
-                    None => e,
-                })?)
-            }
-            Err(m) => Err(Error::deck(span, m)),
-        },
-        Reference::Immediate(text, fmt) => {
-            let x = vars.eval_expr(text, ctx).map_err(|m| Error::deck(span, m))?;
-            match fmt {
-                None => Ok(cfmt::fmt_g(x, 20)),
-                Some(f) => cfmt::sprintf(f, &[cfmt::CArg::Float(x)]).map_err(|m| Error::deck(span, format!("invalid format '{f}' in immediate variable: {m}"))),
-            }
-        }
-    }
+    super::vars::resolve_reference(vars, r, span, ctx)
 }

@@ -44,7 +44,7 @@ impl Text {
     /// Append a string with one span for all its bytes.
     pub fn push_str(&mut self, s: &str, span: Span) {
         self.s.push_str(s);
-        self.spans.extend(std::iter::repeat(span).take(s.len()));
+        self.spans.extend(std::iter::repeat_n(span, s.len()));
     }
     /// Append another text.
     pub fn push_text(&mut self, t: &Text) {

@@ -114,7 +114,7 @@ impl Clone for Rng {
 impl Rng {
     /// Uniform in (0,1); seeded by `seed` on first use (as LAMMPS seeds once).
     fn uniform(&self, seed: f64) -> std::result::Result<f64, String> {
-        if !(seed >= 1.0) {
+        if seed.is_nan() || seed < 1.0 {
             return Err("invalid seed for random()/normal() in variable formula (must be > 0)".into());
         }
         let mut g = self.0.lock().map_err(|_| "random generator poisoned".to_string())?;
@@ -145,8 +145,9 @@ enum Val {
     V(Vec<f64>),
 }
 
-/// How deep variables may refer to variables before it is called circular.
-const MAX_DEPTH: usize = 64;
+/// How deep evaluation may recurse (formula nesting plus variables referring
+/// to variables) before it is called circular; keeps the stack bounded.
+const MAX_DEPTH: usize = 1500;
 
 fn valid_name(name: &str) -> bool {
     !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
@@ -376,6 +377,13 @@ impl Variables {
 
     /// The text `${name}` is replaced by. `Ok(None)` if the variable is not defined.
     pub fn retrieve(&self, name: &str, ctx: &dyn EvalContext) -> std::result::Result<Option<String>, String> {
+        self.retrieve_depth(name, ctx, 0)
+    }
+
+    fn retrieve_depth(&self, name: &str, ctx: &dyn EvalContext, depth: usize) -> std::result::Result<Option<String>, String> {
+        if depth > MAX_DEPTH {
+            return Err(format!("variable '{name}' has a circular dependency (or is nested too deeply)"));
+        }
         let Some(v) = self.vars.get(name) else { return Ok(None) };
         Ok(Some(match &v.data {
             Data::List { values, which } => values.get(*which).cloned().unwrap_or_default(),
@@ -383,14 +391,23 @@ impl Variables {
             Data::Str(s) => s.clone(),
             Data::Getenv(k) => std::env::var(k).unwrap_or_default(),
             Data::Format { var, fmt } => {
-                let x = self.eval_equal_depth(var, ctx, 1)?;
+                let x = self.eval_equal_depth(var, ctx, depth + 1)?;
                 cfmt::sprintf(fmt, &[cfmt::CArg::Float(x)])?
             }
             Data::Formula { .. } if v.style == VarStyle::Atom => {
                 return Err(format!("atom-style variable '{name}' cannot be substituted with $"));
             }
-            Data::Formula { .. } | Data::Internal(_) => cfmt::fmt_g(self.eval_equal_depth(name, ctx, 0)?, 15),
+            Data::Formula { .. } | Data::Internal(_) => cfmt::fmt_g(self.eval_equal_depth(name, ctx, depth + 1)?, 15),
         }))
+    }
+
+    /// Substitute `$x`, `${name}` and `$(expr)` in text, as `print` and
+    /// `fix print` do when they run (quoted parts are left as they are).
+    /// Errors point at the word.
+    pub fn substitute_word(&self, w: &Word, ctx: &dyn EvalContext) -> Result<String> {
+        let t = super::lexer::Text::uniform(&w.text, w.span);
+        let (out, _) = super::lexer::substitute(&t, &mut |r, sp| resolve_reference(self, r, sp, ctx))?;
+        Ok(out.s)
     }
 
     /// The value of a variable as text (what `${name}` gives).
@@ -413,7 +430,7 @@ impl Variables {
 
     fn eval_equal_depth(&self, name: &str, ctx: &dyn EvalContext, depth: usize) -> std::result::Result<f64, String> {
         if depth > MAX_DEPTH {
-            return Err(format!("variable '{name}' has a circular dependency"));
+            return Err(format!("variable '{name}' has a circular dependency (or is nested too deeply)"));
         }
         let Some(v) = self.vars.get(name) else { return Err(self.undefined(name)) };
         match &v.data {
@@ -423,8 +440,9 @@ impl Variables {
             },
             Data::Formula { .. } => Err(format!("atom-style variable '{name}' used where a single number is needed")),
             Data::Internal(x) => Ok(*x),
+            Data::Format { var, .. } if var == name => Err(format!("format variable '{name}' formats itself (circular dependency)")),
             _ => {
-                let s = self.retrieve(name, ctx)?.unwrap_or_default();
+                let s = self.retrieve_depth(name, ctx, depth + 1)?.unwrap_or_default();
                 s.trim().parse::<f64>().map_err(|_| format!("variable '{name}' has the non-numeric value '{s}'"))
             }
         }
@@ -485,6 +503,10 @@ impl Variables {
     }
 
     fn eval(&self, e: &Expr, ctx: &dyn EvalContext, atom: bool, depth: usize) -> std::result::Result<Val, String> {
+        if depth > MAX_DEPTH {
+            return Err("variable formula nested too deeply (circular dependency between variables?)".into());
+        }
+        let depth = depth + 1;
         Ok(match e {
             Expr::Num(x) => Val::S(*x),
             Expr::Neg(a) => map1(self.eval(a, ctx, atom, depth)?, |x| Ok(-x))?,
@@ -600,6 +622,32 @@ impl Variables {
                 mapn(vals, |a| apply_step_fn(name, a, step, begin, end, dt))
             }
             _ => mapn(vals, |a| apply_math(name, a)),
+        }
+    }
+}
+
+/// The text a `$` reference stands for: `${v}` as [`Variables::retrieve`]
+/// gives it, `$(expr)` formatted `%.20g` or with its `:%fmt`.
+pub fn resolve_reference(vars: &Variables, r: &super::lexer::Reference, span: Span, ctx: &dyn EvalContext) -> Result<String> {
+    use super::lexer::Reference;
+    match r {
+        Reference::Var(name) => match vars.retrieve(name, ctx) {
+            Ok(Some(s)) => Ok(s),
+            Ok(None) => {
+                let e = Error::deck(span, format!("variable '{name}' is not defined"));
+                Err(match vars.suggest(name) {
+                    Some(h) => e.with_hint(h),
+                    None => e,
+                })
+            }
+            Err(m) => Err(Error::deck(span, m)),
+        },
+        Reference::Immediate(text, fmt) => {
+            let x = vars.eval_expr(text, ctx).map_err(|m| Error::deck(span, m))?;
+            match fmt {
+                None => Ok(cfmt::fmt_g(x, 20)),
+                Some(f) => cfmt::sprintf(f, &[cfmt::CArg::Float(x)]).map_err(|m| Error::deck(span, format!("invalid format '{f}' in immediate variable: {m}"))),
+            }
         }
     }
 }
