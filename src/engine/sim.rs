@@ -67,6 +67,8 @@ pub struct Sim {
     pub run_start: i64,
     /// Last step of the current run.
     pub run_end: i64,
+    /// `run ... start S stop E` bounds for ramp() and friends.
+    pub run_bounds: Option<(i64, i64)>,
     /// Time step size.
     pub dt: f64,
     /// Simulated time.
@@ -85,6 +87,10 @@ pub struct Sim {
     pub last_rate: f64,
     /// Time spent per section of the last run: pair, neigh, modify, output.
     pub timing: [f64; 4],
+    /// The state came from a restart file: the next run starts from the
+    /// saved pair list and forces instead of recomputing them, so it continues
+    /// bitwise as the uninterrupted run would have.
+    pub resume: bool,
 }
 
 impl Default for Sim {
@@ -107,6 +113,7 @@ impl Default for Sim {
             step: 0,
             run_start: 0,
             run_end: 0,
+            run_bounds: None,
             dt: 1e-5,
             time: 0.0,
             lost: 0,
@@ -116,6 +123,7 @@ impl Default for Sim {
             boltz: 1.380649e-23,
             last_rate: 0.0,
             timing: [0.0; 4],
+            resume: false,
         }
     }
 }
@@ -208,11 +216,28 @@ impl Sim {
     }
 
     /// Forces at the start of a run (LAMMPS `Verlet::setup`).
+    ///
+    /// As in LAMMPS (`update->setupflag`), computing the setup forces does not
+    /// advance contact history: pair and wall histories are restored after it.
+    /// After `read_restart` the saved pair list and forces are used as they are.
     pub fn setup(&mut self, vars: &Variables) -> Result<()> {
         self.each_fix(|f, s| f.setup(s))?;
+        if self.resume && self.model.as_ref().map_or(0, |m| m.kernel.history_width()) == self.pairs.width {
+            self.resume = false;
+            return Ok(());
+        }
+        self.resume = false;
         self.rebuild()?;
+        let hist = self.pairs.hist.clone();
+        let extra: Vec<Vec<f64>> = self.particles.extra.iter().map(|e| e.data.clone()).collect();
         self.pair_forces();
         self.each_fix(|f, s| f.post_force(s, vars))?;
+        self.pairs.hist = hist;
+        for (e, d) in self.particles.extra.iter_mut().zip(extra) {
+            if e.data.len() == d.len() {
+                e.data = d;
+            }
+        }
         Ok(())
     }
 
@@ -382,6 +407,9 @@ impl EvalContext for Sim {
     }
     fn natoms(&self) -> usize {
         self.particles.len()
+    }
+    fn run_bounds(&self) -> Option<(i64, i64)> {
+        Some(self.run_bounds.unwrap_or((self.run_start, self.run_end)))
     }
     fn atom_vector(&self, keyword: &str) -> std::result::Result<Vec<f64>, String> {
         (0..self.particles.len())

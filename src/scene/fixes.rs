@@ -100,6 +100,9 @@ impl Fix for Gravity {
     fn summary(&self) -> String {
         format!("gravity {:?} (fix {})", [self.acc.x, self.acc.y, self.acc.z], self.id)
     }
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }
 
 /// `fix ID group freeze`: zero force and torque; contact partners see
@@ -272,7 +275,7 @@ pub struct Print {
     /// Every N steps.
     pub every: i64,
     /// Text with `$` references, substituted when printed.
-    pub text: String,
+    pub text: crate::script::Word,
     /// Output file.
     pub file: Option<std::fs::File>,
     /// Print to screen.
@@ -291,7 +294,7 @@ impl Fix for Print {
         if self.every <= 0 || sim.step % self.every != 0 {
             return Ok(());
         }
-        let line = substitute_runtime(vars, &self.text, sim).map_err(|e| Error::runtime(format!("fix print {}: {e}", self.id)))?;
+        let line = vars.substitute_word(&self.text, sim)?;
         if self.screen {
             sim.log.line(&line);
         }
@@ -330,7 +333,12 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
                 _ => {
                     let phi = a.f64("phi")?.to_radians();
                     let theta = a.f64("theta")?.to_radians();
-                    V3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+                    if sim.domain.as_ref().map_or(false, |d| d.dimension == 2) {
+                        // LAMMPS FixGravity 2d: x = sin(theta), y = cos(theta)
+                        V3::new(theta.sin(), theta.cos(), 0.0)
+                    } else {
+                        V3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+                    }
                 }
             };
             let len = dir.norm();
@@ -368,7 +376,7 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
         }
         "print" => {
             let every = a.i64("N")?;
-            let text = a.str("text")?.to_string();
+            let text = a.word("text")?.clone();
             let mut file = None;
             let mut screen = true;
             while a.more() {
@@ -400,62 +408,3 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
     }))
 }
 
-/// Substitute `$x`, `${name}` and `$(expr)` in a text at run time (fix print),
-/// formatting numbers as LAMMPS does for equal-style variables (%.15g) and
-/// immediate expressions (%.20g).
-pub fn substitute_runtime(vars: &Variables, text: &str, ctx: &dyn EvalContext) -> std::result::Result<String, String> {
-    let b = text.as_bytes();
-    let mut out = String::with_capacity(text.len());
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] != b'$' || i + 1 >= b.len() {
-            let ch = text[i..].chars().next().unwrap_or(' ');
-            out.push(ch);
-            i += ch.len_utf8();
-            continue;
-        }
-        let (inner, end, immediate) = match b[i + 1] {
-            b'{' => {
-                let k = text[i + 2..].find('}').ok_or("missing } in variable reference")?;
-                (&text[i + 2..i + 2 + k], i + 3 + k, false)
-            }
-            b'(' => {
-                let mut depth = 0;
-                let mut k = i + 1;
-                while k < b.len() {
-                    match b[k] {
-                        b'(' => depth += 1,
-                        b')' => {
-                            depth -= 1;
-                            if depth == 0 {
-                                break;
-                            }
-                        }
-                        _ => {}
-                    }
-                    k += 1;
-                }
-                if k >= b.len() {
-                    return Err("missing ) in immediate expression".into());
-                }
-                (&text[i + 2..k], k + 1, true)
-            }
-            _ => (&text[i + 1..i + 2], i + 2, false),
-        };
-        if immediate {
-            let (expr, fmt) = match inner.rfind(':') {
-                Some(c) if inner[c + 1..].starts_with('%') => (&inner[..c], Some(&inner[c + 1..])),
-                _ => (inner, None),
-            };
-            let v = vars.eval_expr(expr, ctx)?;
-            match fmt {
-                Some(f) => out.push_str(&crate::io::cfmt::sprintf(f, &[crate::io::cfmt::CArg::Float(v)])?),
-                None => out.push_str(&crate::io::cfmt::fmt_g(v, 20)),
-            }
-        } else {
-            out.push_str(&vars.string_value(inner, ctx)?);
-        }
-        i = end;
-    }
-    Ok(out)
-}

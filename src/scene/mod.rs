@@ -11,6 +11,7 @@ pub mod setup;
 pub mod outputs;
 pub mod summary;
 pub mod walls;
+pub mod restart;
 pub mod insert;
 pub mod mesh;
 
@@ -78,6 +79,9 @@ pub struct Session {
     pub walls: Vec<String>,
     /// Particle sources for the summary.
     pub sources: Vec<String>,
+    /// Commands that define units, materials and the contact model, replayed
+    /// by `read_restart`.
+    pub replay: Vec<String>,
 }
 
 /// Commands that only tune MPI, communication or memory: accepted, recorded,
@@ -93,6 +97,7 @@ const NOOP_COMMANDS: &[&str] = &[
     "suffix",
     "balance",
     "atom_modify",
+    "compute_modify",
     "neigh_modify_noop",
     "sort",
     "timer",
@@ -110,7 +115,6 @@ const KNOWN_UNSUPPORTED: &[&str] = &[
     "rerun",
     "read_dump",
     "write_dump",
-    "change_box",
     "replicate",
     "create_bonds",
     "bond_style",
@@ -125,11 +129,9 @@ const KNOWN_UNSUPPORTED: &[&str] = &[
     "region_modify",
     "info",
     "clear",
-    "restart",
     "write_coeff",
     "pair_modify",
     "run_style",
-    "compute_modify",
     "reset_atom_ids",
     "delete_bonds",
 ];
@@ -157,6 +159,7 @@ impl Session {
             threads: 1,
             walls: vec![],
             sources: vec![],
+            replay: vec![],
         }
     }
 
@@ -194,9 +197,9 @@ impl Session {
         let name = cmd.name();
         match name {
             "units" | "atom_style" | "boundary" | "dimension" | "neighbor" | "neigh_modify" | "timestep" | "hard_particles"
-            | "soft_particles" | "region" | "create_box" | "lattice" | "create_atoms" | "read_data" | "group" | "set"
-            | "velocity" | "delete_atoms" | "displace_atoms" | "reset_timestep" | "mass" | "write_data" | "write_restart"
-            | "read_restart" => setup::execute(self, cmd, vars),
+            | "soft_particles" | "region" | "create_box" | "lattice" | "create_atoms" | "group" | "set"
+            | "velocity" | "delete_atoms" | "displace_atoms" | "reset_timestep" | "mass" | "change_box" => setup::execute(self, cmd, vars),
+            "write_data" | "write_restart" | "read_restart" | "read_data" | "restart" => restart::execute(self, cmd, vars),
             "pair_style" | "pair_coeff" => model::execute(self, cmd),
             "fix" | "unfix" => self.fix_command(cmd, vars),
             "thermo" | "thermo_style" | "thermo_modify" | "dump" | "dump_modify" | "undump" | "compute" | "uncompute" => {
@@ -264,13 +267,13 @@ impl Session {
         let n = a.i64("number of steps")?;
         let mut upto = false;
         let (mut pre, mut post) = (true, true);
+        let (mut start, mut stop) = (None, None);
         while a.more() {
             let k = a.choice("run keyword", &["upto", "start", "stop", "pre", "post", "every"])?;
             match k.text.as_str() {
                 "upto" => upto = true,
-                "start" | "stop" => {
-                    a.i64("step")?;
-                }
+                "start" => start = Some(a.i64("step")?),
+                "stop" => stop = Some(a.i64("step")?),
                 "pre" => pre = a.yes_no("pre")?,
                 "post" => post = a.yes_no("post")?,
                 _ => return Err(Error::deck(k.span, "run ... every is handled by the interpreter; this form is malformed")),
@@ -283,6 +286,7 @@ impl Session {
         self.need_box(cmd)?;
         model::finalize(self, cmd)?;
         self.schedule.push(RunRecord { steps, start: self.sim.step, particles: self.sim.particles.len() });
+        self.sim.run_bounds = Some((start.unwrap_or(self.sim.step), stop.unwrap_or(self.sim.step + steps)));
         if !self.sim.fixes.iter().any(|f| f.integrates()) && !self.check {
             self.sim.log.line("WARNING: No fixes defined, atoms won't move");
         }
@@ -292,13 +296,30 @@ impl Session {
 
 /// Every command name demx knows (for did-you-mean).
 pub const ALL_COMMANDS: &[&str] = &[
-    "units", "atom_style", "atom_modify", "boundary", "dimension", "newton", "communicate", "comm_modify", "processors",
+    "units", "atom_style", "atom_modify",
+    "compute_modify", "boundary", "dimension", "newton", "communicate", "comm_modify", "processors",
     "neighbor", "neigh_modify", "timestep", "region", "create_box", "lattice", "create_atoms", "read_data", "group", "set",
     "velocity", "delete_atoms", "displace_atoms", "pair_style", "pair_coeff", "fix", "unfix", "compute", "uncompute",
     "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump", "run", "write_restart", "read_restart",
     "write_data", "reset_timestep", "hard_particles", "soft_particles", "variable", "print", "include", "jump", "label",
     "next", "if", "log", "echo", "quit", "mass",
 ];
+
+impl Session {
+    /// Execute a replayed command (from a restart file) without recording it again.
+    pub fn execute_replay(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
+        self.dispatch(cmd, vars)
+    }
+}
+
+/// Whether a command belongs in a restart file's replay list.
+fn replayed(cmd: &Command) -> bool {
+    match cmd.name() {
+        "units" | "atom_style" | "pair_style" | "pair_coeff" | "hard_particles" | "dimension" => true,
+        "fix" => cmd.words.get(3).map_or(false, |w| w.text == "property/global"),
+        _ => false,
+    }
+}
 
 impl EvalContext for Session {
     fn thermo(&self, name: &str) -> Option<f64> {
@@ -319,6 +340,9 @@ impl EvalContext for Session {
     fn natoms(&self) -> usize {
         self.sim.natoms()
     }
+    fn run_bounds(&self) -> Option<(i64, i64)> {
+        self.sim.run_bounds()
+    }
     fn atom_vector(&self, k: &str) -> std::result::Result<Vec<f64>, String> {
         self.sim.atom_vector(k)
     }
@@ -329,7 +353,11 @@ impl EvalContext for Session {
 
 impl Host for Session {
     fn execute(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
-        self.dispatch(cmd, vars)
+        self.dispatch(cmd, vars)?;
+        if replayed(cmd) {
+            self.replay.push(cmd.text());
+        }
+        Ok(())
     }
     fn output(&mut self, text: &str) {
         self.sim.log.line(text);

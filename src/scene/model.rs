@@ -63,6 +63,16 @@ pub enum TangentialSpec {
 pub enum CohesionSpec {
     /// None.
     Off,
+    /// LIGGGHTS `cohesion sjkr`.
+    Sjkr {
+        /// `tangential_reduce on`.
+        tangential_reduce: bool,
+    },
+    /// LIGGGHTS `cohesion sjkr2`.
+    Sjkr2 {
+        /// `tangential_reduce on`.
+        tangential_reduce: bool,
+    },
 }
 
 /// Rolling law.
@@ -70,6 +80,28 @@ pub enum CohesionSpec {
 pub enum RollingSpec {
     /// None.
     Off,
+    /// LIGGGHTS `rolling_friction cdt`.
+    Cdt,
+    /// LIGGGHTS `rolling_friction epsd`.
+    Epsd {
+        /// `torsionTorque on`.
+        torsion: bool,
+    },
+    /// LIGGGHTS `rolling_friction epsd2`.
+    Epsd2 {
+        /// `torsionTorque on`.
+        torsion: bool,
+    },
+    /// LIGGGHTS `rolling_friction epsd3`.
+    Epsd3 {
+        /// `torsionTorque on`.
+        torsion: bool,
+    },
+    /// LAMMPS granular `rolling sds` (with `twisting sds` when set).
+    Sds {
+        /// `twisting sds` too.
+        twisting: bool,
+    },
 }
 
 /// The declared contact model.
@@ -116,53 +148,99 @@ impl PairSpec {
             TangentialSpec::LigHistory | TangentialSpec::GranHistory => "tangential history".into(),
             TangentialSpec::Granular(g) => format!("tangential {g:?}").to_lowercase(),
         };
-        format!("{n} + {t}; cohesion: none; rolling: none")
+        let c = match self.cohesion {
+            CohesionSpec::Off => "none".to_string(),
+            CohesionSpec::Sjkr { .. } => "sjkr".into(),
+            CohesionSpec::Sjkr2 { .. } => "sjkr2".into(),
+        };
+        let r = match self.rolling {
+            RollingSpec::Off => "none".to_string(),
+            RollingSpec::Cdt => "cdt".into(),
+            RollingSpec::Epsd { .. } => "epsd".into(),
+            RollingSpec::Epsd2 { .. } => "epsd2".into(),
+            RollingSpec::Epsd3 { .. } => "epsd3".into(),
+            RollingSpec::Sds { twisting } => if twisting { "sds + twisting sds".into() } else { "sds".into() },
+        };
+        format!("{n} + {t}; cohesion: {c}; rolling: {r}")
     }
 }
 
 // ---------------------------------------------------------------- kernel choice
 
-/// Build the kernel for a spec: one generic step per model axis.
-pub fn build_kernel(spec: &PairSpec) -> Box<dyn ContactKernel> {
-    match spec.normal {
-        NormalSpec::LigHooke { kt_to_kn } => with_tangential(normal::hooke::LiggghtsHooke { kt_to_kn }, spec),
+/// Build the kernel for a spec: one generic step per model axis. The deck
+/// language only combines laws of one engine (LIGGGHTS `pair_style gran` or
+/// LAMMPS `gran/*` / `granular`), so the walk is split by dialect: every
+/// combination a deck can express compiles (LIGGGHTS 4 x 2 x 3 x 5, LAMMPS
+/// 3 x 4 x 2), none that no deck can express.
+pub fn build_kernel(spec: &PairSpec) -> Result<Box<dyn ContactKernel>> {
+    let k = match spec.normal {
+        NormalSpec::LigHooke { kt_to_kn } => lig_tangential(normal::hooke::LiggghtsHooke { kt_to_kn }, spec),
         NormalSpec::LigHookeStiffness { absolute } => {
-            with_tangential(normal::hooke_stiffness::LiggghtsHookeStiffness { absolute_damping: absolute }, spec)
+            lig_tangential(normal::hooke_stiffness::LiggghtsHookeStiffness { absolute_damping: absolute }, spec)
         }
-        NormalSpec::LigHertz => with_tangential(normal::hertz::LiggghtsHertz, spec),
-        NormalSpec::LigHertzStiffness => with_tangential(normal::hertz_stiffness::LiggghtsHertzStiffness, spec),
-        NormalSpec::GranHooke => with_tangential(normal::gran::LammpsGranHooke, spec),
-        NormalSpec::GranHertz => with_tangential(normal::gran::LammpsGranHertz, spec),
-        NormalSpec::Granular(model, damping) => with_tangential(normal::granular::LammpsGranular { model, damping }, spec),
-    }
+        NormalSpec::LigHertz => lig_tangential(normal::hertz::LiggghtsHertz, spec),
+        NormalSpec::LigHertzStiffness => lig_tangential(normal::hertz_stiffness::LiggghtsHertzStiffness, spec),
+        NormalSpec::GranHooke => lmp_tangential(normal::gran::LammpsGranHooke, spec),
+        NormalSpec::GranHertz => lmp_tangential(normal::gran::LammpsGranHertz, spec),
+        NormalSpec::Granular(model, damping) => lmp_tangential(normal::granular::LammpsGranular { model, damping }, spec),
+    };
+    k.ok_or_else(|| Error::deck(spec.span, format!("contact model mixes LIGGGHTS and LAMMPS laws: {}", spec.summary())))
 }
 
-fn with_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Box<dyn ContactKernel> {
+fn lig_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
     match spec.tangential {
-        TangentialSpec::LigNoHistory => with_cohesion(n, tangential::no_history::LiggghtsNoHistory, spec),
-        TangentialSpec::LigHistory => with_cohesion(n, tangential::history::LiggghtsHistory, spec),
-        TangentialSpec::GranNoHistory => with_cohesion(n, tangential::gran::LammpsGranNoHistory, spec),
-        TangentialSpec::GranHistory => with_cohesion(n, tangential::gran::LammpsGranHistory, spec),
-        TangentialSpec::LinearNoHistory => with_cohesion(n, tangential::granular::LammpsLinearNoHistory, spec),
-        TangentialSpec::Granular(model) => with_cohesion(n, tangential::granular::LammpsGranularHistory { model }, spec),
+        TangentialSpec::LigNoHistory => lig_cohesion(n, tangential::no_history::LiggghtsNoHistory, spec),
+        TangentialSpec::LigHistory => lig_cohesion(n, tangential::history::LiggghtsHistory, spec),
+        _ => None,
     }
 }
 
-fn with_cohesion<N: NormalLaw + Send + 'static, T: TangentialLaw + Send + 'static>(n: N, t: T, spec: &PairSpec) -> Box<dyn ContactKernel> {
+fn lig_cohesion<N: NormalLaw + Send + 'static, T: TangentialLaw + Send + 'static>(n: N, t: T, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
+    use crate::physics::cohesion::{sjkr::LiggghtsSjkr, sjkr2::LiggghtsSjkr2};
     match spec.cohesion {
-        CohesionSpec::Off => with_rolling(n, t, NoCohesion, spec),
+        CohesionSpec::Off => lig_rolling(n, t, NoCohesion, spec),
+        CohesionSpec::Sjkr { tangential_reduce } => lig_rolling(n, t, LiggghtsSjkr { tangential_reduce }, spec),
+        CohesionSpec::Sjkr2 { tangential_reduce } => lig_rolling(n, t, LiggghtsSjkr2 { tangential_reduce }, spec),
     }
 }
 
-fn with_rolling<N, T, C>(n: N, t: T, c: C, spec: &PairSpec) -> Box<dyn ContactKernel>
+fn lig_rolling<N, T, C>(n: N, t: T, c: C, spec: &PairSpec) -> Option<Box<dyn ContactKernel>>
 where
     N: NormalLaw + Send + 'static,
     T: TangentialLaw + Send + 'static,
     C: CohesionLaw + Send + 'static,
 {
-    match spec.rolling {
+    use crate::physics::rolling::{cdt::LiggghtsCdt, epsd::LiggghtsEpsd, epsd2::LiggghtsEpsd2, epsd3::LiggghtsEpsd3};
+    Some(match spec.rolling {
         RollingSpec::Off => finish(n, t, c, NoRolling),
+        RollingSpec::Cdt => finish(n, t, c, LiggghtsCdt),
+        RollingSpec::Epsd { torsion } => finish(n, t, c, LiggghtsEpsd { torsion_torque: torsion }),
+        RollingSpec::Epsd2 { torsion } => finish(n, t, c, LiggghtsEpsd2 { torsion_torque: torsion }),
+        RollingSpec::Epsd3 { torsion } => finish(n, t, c, LiggghtsEpsd3 { torsion_torque: torsion }),
+        RollingSpec::Sds { .. } => return None,
+    })
+}
+
+fn lmp_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
+    if spec.cohesion != CohesionSpec::Off {
+        return None;
     }
+    match spec.tangential {
+        TangentialSpec::GranNoHistory => lmp_rolling(n, tangential::gran::LammpsGranNoHistory, spec),
+        TangentialSpec::GranHistory => lmp_rolling(n, tangential::gran::LammpsGranHistory, spec),
+        TangentialSpec::LinearNoHistory => lmp_rolling(n, tangential::granular::LammpsLinearNoHistory, spec),
+        TangentialSpec::Granular(model) => lmp_rolling(n, tangential::granular::LammpsGranularHistory { model }, spec),
+        _ => None,
+    }
+}
+
+fn lmp_rolling<N: NormalLaw + Send + 'static, T: TangentialLaw + Send + 'static>(n: N, t: T, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
+    use crate::physics::rolling::sds::LammpsSds;
+    Some(match spec.rolling {
+        RollingSpec::Off => finish(n, t, NoCohesion, NoRolling),
+        RollingSpec::Sds { twisting } => finish(n, t, NoCohesion, LammpsSds { twisting }),
+        _ => return None,
+    })
 }
 
 fn finish<N, T, C, R>(normal: N, tangential: T, cohesion: C, rolling: R) -> Box<dyn ContactKernel>
@@ -336,21 +414,27 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
             }
             "cohesion" => {
                 let c = a.word("cohesion model")?;
-                return Err(match c.text.as_str() {
-                    "sjkr" | "sjkr2" | "easo/capillary/viscous" | "washino/capillary/viscous" => {
-                        Error::unsupported(c.span, format!("cohesion model '{}'", c.text))
+                spec.cohesion = match c.text.as_str() {
+                    "off" => CohesionSpec::Off,
+                    "sjkr" => CohesionSpec::Sjkr { tangential_reduce: false },
+                    "sjkr2" => CohesionSpec::Sjkr2 { tangential_reduce: false },
+                    "easo/capillary/viscous" | "washino/capillary/viscous" => {
+                        return Err(Error::unsupported(c.span, format!("cohesion model '{}'", c.text)))
                     }
-                    "off" => continue,
-                    _ => bad_keyword(c, "cohesion model", &["off", "sjkr", "sjkr2"]),
-                });
+                    _ => return Err(bad_keyword(c, "cohesion model", &["off", "sjkr", "sjkr2"])),
+                };
             }
             "rolling_friction" => {
                 let r = a.word("rolling model")?;
-                return Err(match r.text.as_str() {
-                    "off" => continue,
-                    "cdt" | "epsd" | "epsd2" | "epsd3" | "luding" => Error::unsupported(r.span, format!("rolling_friction model '{}'", r.text)),
-                    _ => bad_keyword(r, "rolling_friction model", &["off", "cdt", "epsd", "epsd2", "epsd3"]),
-                });
+                spec.rolling = match r.text.as_str() {
+                    "off" => RollingSpec::Off,
+                    "cdt" => RollingSpec::Cdt,
+                    "epsd" => RollingSpec::Epsd { torsion: false },
+                    "epsd2" => RollingSpec::Epsd2 { torsion: false },
+                    "epsd3" => RollingSpec::Epsd3 { torsion: false },
+                    "luding" => return Err(Error::unsupported(r.span, "rolling_friction model 'luding'")),
+                    _ => return Err(bad_keyword(r, "rolling_friction model", &["off", "cdt", "epsd", "epsd2", "epsd3"])),
+                };
             }
             "surface" => {
                 let sfc = a.word("surface model")?;
@@ -374,8 +458,21 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                     *absolute = on;
                 }
             }
-            "heating_normal_hertz" | "computeDissipatedEnergy" | "computeElasticPotential" | "disableNormalWhenBonded" | "torsionTorque"
-            | "tangential_reduce" => {
+            "torsionTorque" => {
+                let on = a.yes_no("torsionTorque")?;
+                match &mut spec.rolling {
+                    RollingSpec::Epsd { torsion } | RollingSpec::Epsd2 { torsion } | RollingSpec::Epsd3 { torsion } => *torsion = on,
+                    _ => {}
+                }
+            }
+            "tangential_reduce" => {
+                let on = a.yes_no("tangential_reduce")?;
+                match &mut spec.cohesion {
+                    CohesionSpec::Sjkr { tangential_reduce } | CohesionSpec::Sjkr2 { tangential_reduce } => *tangential_reduce = on,
+                    _ => {}
+                }
+            }
+            "heating_normal_hertz" | "computeDissipatedEnergy" | "computeElasticPotential" | "disableNormalWhenBonded" => {
                 let v = a.yes_no(&k.text.clone())?;
                 if v && k.text != "computeDissipatedEnergy" && k.text != "computeElasticPotential" {
                     return Err(Error::unsupported(k.span, format!("model option {} on", k.text)));
@@ -533,75 +630,80 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
             }
         }
         _ => {
-            let need = |name: &str| -> Result<&Vec<f64>> {
-                prop(s, name).ok_or_else(|| {
-                    Error::deck(span, format!("pair_style gran needs `fix ID all property/global {name} ...`"))
-                        .with_hint("LIGGGHTS reads material properties from fix property/global")
-                })
-            };
-            let per_type = |name: &str, v: &Vec<f64>, i: usize| -> Result<f64> {
-                v.get(i - 1).copied().ok_or_else(|| Error::deck(span, format!("property/global {name} has {} values, needs one per atom type ({nt})", v.len())))
-            };
-            let per_pair = |name: &str, v: &Vec<f64>, i: usize, j: usize| -> Result<f64> {
-                // stored as N then N*N values
-                let n = v.first().copied().unwrap_or(0.0) as usize;
-                if n < nt || v.len() < 1 + n * n {
-                    return Err(Error::deck(span, format!("property/global {name} must be peratomtypepair {nt} with {} values", nt * nt)));
+            use crate::physics::mixing::{liggghts_pair_params, LiggghtsMaterials, LiggghtsSettings};
+            let per_type = |name: &str| prop(s, name).cloned();
+            // peratomtypepair values are stored as [N, v11, v12, ...]
+            let per_pair = |name: &str| -> Result<Option<Vec<f64>>> {
+                match prop(s, name).or_else(|| prop(s, &format!("{name}_abs"))) {
+                    None => Ok(None),
+                    Some(v) => {
+                        let n = v.first().copied().unwrap_or(0.0) as usize;
+                        if n != nt || v.len() != 1 + n * n {
+                            return Err(Error::deck(span, format!("property/global {name} must be `peratomtypepair {nt}` followed by {} values", nt * nt)));
+                        }
+                        Ok(Some(v[1..].to_vec()))
+                    }
                 }
-                Ok(v[1 + (i - 1) * n + (j - 1)])
+            };
+            let scalar = |name: &str| prop(s, name).and_then(|v| v.first().copied());
+            let m = LiggghtsMaterials {
+                n_types: nt,
+                youngs: per_type("youngsModulus"),
+                poisson: per_type("poissonsRatio"),
+                restitution: per_pair("coefficientRestitution")?,
+                friction: per_pair("coefficientFriction")?,
+                rolling_friction: per_pair("coefficientRollingFriction")?,
+                rolling_damping: per_pair("coefficientRollingViscousDamping")?,
+                cohesion_energy_density: per_pair("cohesionEnergyDensity")?,
+                char_vel: scalar("characteristicVelocity"),
+                rolling_stiffness: scalar("coeffRollingStiffness"),
+                kn: per_pair("kn")?,
+                kt: per_pair("kt")?,
+                gamman: per_pair("gamman")?,
+                gammat: per_pair("gammat")?,
             };
             let stiff = matches!(spec.normal, NormalSpec::LigHookeStiffness { .. } | NormalSpec::LigHertzStiffness);
-            let y = if stiff { None } else { Some(need("youngsModulus")?) };
-            let nu = if stiff { None } else { Some(need("poissonsRatio")?) };
-            let e = if stiff { None } else { Some(need("coefficientRestitution")?) };
-            let mu = if matches!(spec.tangential, TangentialSpec::LigHistory | TangentialSpec::LigNoHistory) {
-                Some(need("coefficientFriction")?)
+            let mut needed: Vec<(&str, bool)> = vec![];
+            if stiff {
+                needed.extend([("kn", m.kn.is_some()), ("kt", m.kt.is_some()), ("gamman", m.gamman.is_some()), ("gammat", m.gammat.is_some())]);
             } else {
-                None
-            };
-            let cv = if matches!(spec.normal, NormalSpec::LigHooke { .. }) { Some(need("characteristicVelocity")?) } else { None };
+                needed.extend([
+                    ("youngsModulus", m.youngs.is_some()),
+                    ("poissonsRatio", m.poisson.is_some()),
+                    ("coefficientRestitution", m.restitution.is_some()),
+                ]);
+            }
+            needed.push(("coefficientFriction", m.friction.is_some()));
+            if matches!(spec.normal, NormalSpec::LigHooke { .. }) {
+                needed.push(("characteristicVelocity", m.char_vel.is_some()));
+            }
+            if !matches!(spec.cohesion, CohesionSpec::Off) {
+                needed.push(("cohesionEnergyDensity", m.cohesion_energy_density.is_some()));
+            }
+            if !matches!(spec.rolling, RollingSpec::Off) {
+                needed.push(("coefficientRollingFriction", m.rolling_friction.is_some()));
+            }
+            if matches!(spec.rolling, RollingSpec::Epsd { .. } | RollingSpec::Epsd3 { .. }) {
+                needed.push(("coefficientRollingViscousDamping", m.rolling_damping.is_some()));
+            }
+            if matches!(spec.rolling, RollingSpec::Epsd3 { .. }) {
+                needed.push(("coeffRollingStiffness", m.rolling_stiffness.is_some()));
+            }
+            if let Some((name, _)) = needed.iter().find(|(_, have)| !have) {
+                return Err(Error::deck(span, format!("this contact model needs `fix ID all property/global {name} ...`"))
+                    .with_hint("LIGGGHTS reads material properties from fix property/global, defined before the run"));
+            }
+            if s.units == super::Units::Si && !s.hard_particles {
+                if let Some(y) = m.youngs.as_ref().and_then(|y| y.iter().cloned().find(|&v| v > 1e9)) {
+                    return Err(Error::deck(span, format!("youngsModulus {y} > 1e9 needs `hard_particles yes` (as in LIGGGHTS)"))
+                        .with_hint("add `hard_particles yes` before the pair_style"));
+                }
+            }
+            let settings = LiggghtsSettings { tangential_damping: spec.tangential_damping, limit_force: spec.limit_damping, units_si: s.units == super::Units::Si };
+            let table = liggghts_pair_params(&m, &settings, span)?;
             for i in 1..=nt {
                 for j in 1..=nt {
-                    let mut p = PairParams::default();
-                    if let (Some(y), Some(nu)) = (y, nu) {
-                        let (yi, yj) = (per_type("youngsModulus", y, i)?, per_type("youngsModulus", y, j)?);
-                        let (ni, nj) = (per_type("poissonsRatio", nu, i)?, per_type("poissonsRatio", nu, j)?);
-                        if s.units == super::Units::Si && (yi > 1e9 || yj > 1e9) && !s.hard_particles {
-                            return Err(Error::deck(span, format!("youngsModulus {} > 1e9 needs `hard_particles yes` (as in LIGGGHTS)", yi.max(yj)))
-                                .with_hint("add `hard_particles yes` before the pair_style"));
-                        }
-                        p.y_eff = crate::physics::mixing::liggghts_y_eff(yi, ni, yj, nj);
-                        p.g_eff = crate::physics::mixing::liggghts_g_eff(yi, ni, yj, nj);
-                    }
-                    if let Some(e) = e {
-                        let ev = per_pair("coefficientRestitution", e, i, j)?;
-                        p.restitution = ev;
-                        p.beta = crate::physics::mixing::liggghts_beta(ev);
-                    }
-                    if let Some(mu) = mu {
-                        p.mu = per_pair("coefficientFriction", mu, i, j)?;
-                    }
-                    if let Some(cv) = cv {
-                        p.char_vel = cv.first().copied().unwrap_or(0.0);
-                    }
-                    if stiff {
-                        for (name, field) in [("kn", 0), ("kt", 1), ("gamman", 2), ("gammat", 3)] {
-                            let alt = format!("{name}_abs");
-                            let v = prop(s, name).or_else(|| prop(s, &alt)).ok_or_else(|| {
-                                Error::deck(span, format!("model {:?} needs `fix ID all property/global {name} peratomtypepair ...`", spec.normal))
-                            })?;
-                            let val = per_pair(name, v, i, j)?;
-                            match field {
-                                0 => p.kn = val,
-                                1 => p.kt = val,
-                                2 => p.gamma_n = val,
-                                _ => p.gamma_t = val,
-                            }
-                        }
-                    }
-                    p.tangential_damping = if spec.tangential_damping { 1.0 } else { 0.0 };
-                    p.limit_damping = if spec.limit_damping { 1.0 } else { 0.0 };
-                    *t.get_mut(i as u32, j as u32) = p;
+                    *t.get_mut(i as u32, j as u32) = table[(i - 1) * nt + (j - 1)];
                 }
             }
         }
@@ -622,7 +724,7 @@ pub fn finalize(s: &mut Session, _cmd: &Command) -> Result<()> {
         return Err(Error::deck(spec.span, "all pair coeffs are not set").with_hint("add `pair_coeff * *` after pair_style"));
     }
     let table = fill_table(s, &spec, spec.span)?;
-    let kernel = build_kernel(&spec);
+    let kernel = build_kernel(&spec)?;
     s.sim.model = Some(PairModel { kernel, table, summary: spec.summary() });
     Ok(())
 }
@@ -646,6 +748,9 @@ pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: 
             let _ = id;
             s.props.insert(name.text.clone(), (kind.text.clone(), vals));
             Ok(())
+        }
+        "property/atom" if a.rest().get(1).map_or(true, |w| !matches!(w.text.as_str(), "scalar" | "vector")) => {
+            Err(Error::unsupported(style.span, "LAMMPS-style fix property/atom (mol, q, i_/d_ per-atom properties)"))
         }
         "property/atom" => {
             let name = a.word("property name")?;

@@ -162,7 +162,7 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
         "property/atom" => {
             let mut names = vec![];
             for w in a.rest() {
-                if crate::engine::compute::atom_property(&s.sim, &w.text, usize::MAX).is_none() && !is_atom_property_name(&w.text) {
+                if !is_atom_property_name(&w.text) {
                     return Err(Error::unsupported(w.span, format!("compute property/atom {}", w.text)));
                 }
                 names.push(w.text.clone());

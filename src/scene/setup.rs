@@ -46,8 +46,9 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                         Err(Error::unsupported(st.span, format!("atom_style {}", cmd.text().trim_start_matches("atom_style "))))
                     }
                 }
-                "atomic" | "bond" | "molecular" | "full" | "charge" | "body" | "line" | "tri" | "ellipsoid" | "superquadric"
-                | "dipole" | "bpm/sphere" => Err(Error::unsupported(st.span, format!("atom_style {}", st.text)).with_hint("demx simulates spheres: atom_style sphere or granular")),
+                "atomic" | "bond" | "angle" | "molecular" | "full" | "charge" | "body" | "line" | "tri" | "ellipsoid" | "superquadric"
+                | "dipole" | "bpm/sphere" | "sph" | "peri" | "template" | "spin" | "wavepacket" | "electron" | "dpd" | "edpd" | "mdpd"
+                | "tdpd" | "oxdna" | "dielectric" | "granular/multisphere" | "convexhull" => Err(Error::unsupported(st.span, format!("atom_style {}", st.text)).with_hint("demx simulates spheres: atom_style sphere or granular")),
                 _ => Err(bad_keyword(st, "atom style", &["sphere", "granular"])),
             }
         }
@@ -156,13 +157,10 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             let ctx = RegionParseCtx { lattice: lattice_spacing(s), box_bounds: box_bounds(s), regions: &s.regions };
             let r = parse_region(cmd, &ctx)?;
             let _ = vars;
-            match s.regions.iter().position(|x| x.id == r.id) {
-                Some(k) => {
-                    return Err(Error::deck(cmd.args()[0].span, format!("region '{}' is already defined", r.id)));
-                }
-                None => s.regions.push(r),
+            if s.regions.iter().any(|x| x.id == r.id) {
+                return Err(Error::deck(cmd.args()[0].span, format!("region '{}' is already defined", r.id)));
             }
-            let _ = Some(0).map(|k: usize| k);
+            s.regions.push(r);
             Ok(())
         }
         "lattice" => {
@@ -192,7 +190,6 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             Ok(())
         }
         "create_atoms" => create_atoms(s, cmd, &mut a),
-        "read_data" => read_data(s, cmd, &mut a),
         "group" => group_command(s, cmd, &mut a),
         "set" => set_command(s, cmd, &mut a),
         "velocity" => velocity_command(s, cmd, &mut a),
@@ -229,7 +226,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             s.sim.force_rebuild = true;
             Ok(())
         }
-        "write_data" | "write_restart" | "read_restart" => Err(Error::unsupported(cmd.words[0].span, format!("command '{}'", cmd.name()))),
+        "change_box" => change_box(s, cmd, &mut a),
         _ => unreachable!("setup::execute dispatched a command it does not handle"),
     }
 }
@@ -345,11 +342,54 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     Ok(())
 }
 
-fn read_data(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
-    let w = a.word("file")?;
-    Err(Error::unsupported(w.span, "read_data (reader not wired yet)")).map(|_: ()| {
-        let _ = (s, cmd);
-    })
+fn change_box(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    let g = a.word("group")?;
+    s.group(g)?;
+    while a.more() {
+        let k = a.word("keyword")?;
+        match k.text.as_str() {
+            "boundary" => {
+                let mut sides = [[Side::Periodic; 2]; 3];
+                for d in 0..3 {
+                    let w = a.word("boundary")?;
+                    let cs: Vec<char> = w.text.chars().collect();
+                    let pair = if cs.len() == 1 { [cs[0], cs[0]] } else if cs.len() == 2 { [cs[0], cs[1]] } else { return Err(Error::deck(w.span, "illegal boundary")) };
+                    for q in 0..2 {
+                        sides[d][q] = Side::from_char(pair[q]).ok_or_else(|| Error::deck(w.span, "illegal boundary letter"))?;
+                    }
+                }
+                if let Some(d) = s.sim.domain.as_mut() {
+                    d.sides = sides;
+                }
+            }
+            "x" | "y" | "z" => {
+                let d = (k.text.as_bytes()[0] - b'x') as usize;
+                let how = a.choice("change style", &["final", "delta", "scale", "volume"])?;
+                let dom = s.sim.domain.as_mut().ok_or_else(|| Error::runtime("no box"))?;
+                match how.text.as_str() {
+                    "final" => {
+                        dom.lo[d] = a.f64("lo")?;
+                        dom.hi[d] = a.f64("hi")?;
+                    }
+                    "delta" => {
+                        dom.lo[d] += a.f64("dlo")?;
+                        dom.hi[d] += a.f64("dhi")?;
+                    }
+                    _ => return Err(Error::unsupported(how.span, format!("change_box {} {}", k.text, how.text))),
+                }
+                dom.lo0[d] = dom.lo[d];
+                dom.hi0[d] = dom.hi[d];
+            }
+            "units" => {
+                a.choice("units", &["box", "lattice"])?;
+            }
+            "remap" => {}
+            _ => return Err(Error::unsupported(k.span, format!("change_box {}", k.text))),
+        }
+    }
+    s.sim.force_rebuild = true;
+    Ok(())
 }
 
 fn group_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {

@@ -139,7 +139,24 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
     } else {
         s.set_dialect(Dialect::Lammps);
         let mut spec = base_spec(cmd);
-        match first.text.as_str() {
+        // 2012-era LAMMPS: `fix wall/gran Kn Kt gn gt xmu dampflag wallstyle ...`
+        // takes its force style from the pair style.
+        let legacy = super::args::parse_f64(first).is_ok();
+        let style_name: String = if legacy {
+            a.pos -= 1;
+            match s.pair.as_ref().map(|p| p.normal) {
+                Some(NormalSpec::GranHertz) => "hertz/history".into(),
+                Some(NormalSpec::GranHooke) if s.pair.as_ref().map(|p| p.tangential) == Some(TangentialSpec::GranNoHistory) => "hooke".into(),
+                Some(NormalSpec::GranHooke) => "hooke/history".into(),
+                _ => {
+                    return Err(Error::deck(first.span, "fix wall/gran without a force style needs a gran/* pair style defined first")
+                        .with_hint("write the style explicitly, e.g. `fix ID all wall/gran hooke/history Kn Kt gn gt xmu dampflag zplane lo hi`"))
+                }
+            }
+        } else {
+            first.text.clone()
+        };
+        match style_name.as_str() {
             "hooke" | "hooke/history" | "hertz/history" => {
                 let kn = a.f64("Kn")?;
                 let ktw = a.word("Kt")?;
@@ -155,8 +172,8 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
                 }
                 spec.gran = Some([kn, kt, gn, if damp == 0 { 0.0 } else { gt }, xmu]);
                 spec.tangential_damping = damp == 1;
-                spec.normal = if first.text == "hertz/history" { NormalSpec::GranHertz } else { NormalSpec::GranHooke };
-                spec.tangential = if first.text == "hooke" { TangentialSpec::GranNoHistory } else { TangentialSpec::GranHistory };
+                spec.normal = if style_name == "hertz/history" { NormalSpec::GranHertz } else { NormalSpec::GranHooke };
+                spec.tangential = if style_name == "hooke" { TangentialSpec::GranNoHistory } else { TangentialSpec::GranHistory };
             }
             "granular" => return Err(Error::unsupported(first.span, "fix wall/gran granular")),
             _ => {
@@ -179,7 +196,7 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
         (spec, table, 1, wall, motion)
     };
     let _ = style;
-    let kernel = model::build_kernel(&spec);
+    let kernel = model::build_kernel(&spec)?;
     let width = kernel.history_width();
     let summary = format!("wall/gran {} ({:?}): {}", id, wall, spec.summary());
     s.walls.push(summary.clone());
