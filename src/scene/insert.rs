@@ -27,7 +27,8 @@
 //!   as 1), insertions every nfreq = int(t / dt + 0.5) steps with t the fall
 //!   time through the region, first at the step after the fix; positions
 //!   follow LAMMPS' own draw order (height, diameter, x, y per attempt, vx,
-//!   vy, density) with the same generator, so a lone pour reproduces LAMMPS.
+//!   vy, density) with the same generator after LAMMPS' 30 warm-up draws,
+//!   so the first insertion reproduces LAMMPS' positions exactly.
 //!
 //! New particles get ids max_tag()+1.. and the group bits of the insert fix
 //! (and, LIGGGHTS, of the distribution and template fixes) plus `all`.
@@ -1349,7 +1350,14 @@ fn parse_pour(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args
         group,
         ninsert,
         kind: kind as u32,
-        rng: Park::new(seed),
+        rng: {
+            // LAMMPS warms the generator up with 30 draws before first use
+            let mut r = Park::new(seed);
+            for _ in 0..30 {
+                r.uniform();
+            }
+            r
+        },
         region: preg,
         vlo,
         vhi,
