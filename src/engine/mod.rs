@@ -10,5 +10,6 @@ pub mod compute;
 pub mod output;
 pub mod sim;
 pub mod rng;
+pub mod insert;
 
 pub use sim::{Dialect, Sim};
