@@ -10,5 +10,6 @@ pub mod compute;
 pub mod output;
 pub mod sim;
 pub mod rng;
+pub mod mesh_surface;
 
 pub use sim::{Dialect, Sim};
