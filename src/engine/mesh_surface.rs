@@ -60,6 +60,9 @@ pub struct SurfaceMesh {
     pub motion: Option<(MeshMotion, f64)>,
     /// Conveyor velocity (`surface_vel`).
     pub surface_vel: Option<V3>,
+    /// The mover has made a step: node velocities are set. Before that
+    /// (the setup right after `fix move/mesh`) LIGGGHTS sees a resting mesh.
+    pub moving: bool,
 }
 
 fn bits(v: V3) -> [u64; 3] {
@@ -216,7 +219,7 @@ impl SurfaceMesh {
             }).sum::<f64>() / n as f64
         };
         let bins = TriangleBins::new(&mesh, cell);
-        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None }
+        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None, moving: false }
     }
 
     /// Whether every triangle's edge and node neighbours are coplanar with it
@@ -272,8 +275,8 @@ impl SurfaceMesh {
     /// its magnitude).
     pub fn wall_velocity(&self, p: V3, tri: usize, time: f64) -> V3 {
         let mut v = match self.tm(time) {
-            None => V3::zeros(),
-            Some((m, t)) => m.velocity(p, t),
+            Some((m, t)) if self.moving => m.velocity(p, t),
+            _ => V3::zeros(),
         };
         if let Some(sv) = self.surface_vel {
             let n = self.dir_to_world(self.tris[tri].n, time);
@@ -310,6 +313,7 @@ impl SurfaceMesh {
         let cell = self.bins_cell();
         self.bins = TriangleBins::new(&Mesh::new(self.tris.clone()), cell);
         self.motion = None;
+        self.moving = false;
     }
 
     fn bins_cell(&self) -> f64 {

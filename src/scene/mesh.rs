@@ -255,6 +255,7 @@ pub struct MoveMeshFix {
     id: String,
     mesh: SharedMesh,
     now: f64,
+    started: bool,
 }
 
 impl Fix for MoveMeshFix {
@@ -266,6 +267,12 @@ impl Fix for MoveMeshFix {
     }
     fn initial_integrate(&mut self, sim: &mut Sim) {
         self.now = sim.time;
+        if !self.started {
+            if let Ok(mut m) = self.mesh.write() {
+                m.moving = true;
+            }
+            self.started = true;
+        }
     }
 }
 
@@ -306,7 +313,7 @@ fn move_mesh(s: &mut Session, cmd: &Command, id: &str, a: &mut Args) -> Result<(
     }
     s.walls.push(format!("move/mesh {id}: mesh {} {:?}", mw.text, motion));
     let now = s.sim.time;
-    s.add_fix(Box::new(MoveMeshFix { id: id.to_string(), mesh, now }))
+    s.add_fix(Box::new(MoveMeshFix { id: id.to_string(), mesh, now, started: false }))
 }
 
 // ---------------------------------------------------------- wall/gran mesh
@@ -340,6 +347,9 @@ pub struct WallGranMesh {
     table: ParamTable,
     width: usize,
     summary: String,
+    /// The next post_force is the run setup's: history is not advanced
+    /// (LIGGGHTS/LAMMPS `shearupdate = 0` while `update->setupflag`).
+    in_setup: bool,
 }
 
 impl WallGranMesh {
@@ -359,12 +369,14 @@ impl Fix for WallGranMesh {
         for m in &self.meshes {
             sim.particles.add_extra(&m.hist_name, vec![0.0; self.slot_len()]);
         }
+        self.in_setup = true;
         Ok(())
     }
     fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
         let len = self.slot_len();
         let time = sim.time;
-        let dt = sim.dt;
+        // dt = 0 leaves the history where it is (setup force evaluation)
+        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
         for wm in &self.meshes {
             let col = sim.particles.add_extra(&wm.hist_name, vec![0.0; len]);
             let mesh = wm.mesh.read().map_err(|_| lock_err())?;
@@ -468,7 +480,7 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
     let width = kernel.history_width();
     let summary = format!("wall/gran {id} (mesh {}): {}", names.join(" "), spec.summary());
     s.walls.push(summary.clone());
-    s.add_fix(Box::new(WallGranMesh { id: id.to_string(), group, meshes, kernel, table, width, summary }))
+    s.add_fix(Box::new(WallGranMesh { id: id.to_string(), group, meshes, kernel, table, width, summary, in_setup: false }))
 }
 
 // ------------------------------------------------------- wall/gran/region
@@ -488,6 +500,8 @@ pub struct WallGranRegion {
     summary: String,
     /// Displacement and angle at the previous step (wall velocity by differences, as LAMMPS).
     prev: Option<(i64, V3, f64)>,
+    /// The next post_force is the run setup's (history not advanced).
+    in_setup: bool,
 }
 
 impl WallGranRegion {
@@ -505,6 +519,7 @@ impl Fix for WallGranRegion {
     }
     fn setup(&mut self, sim: &mut Sim) -> Result<()> {
         sim.particles.add_extra(&self.hist_name, vec![0.0; self.slot_len()]);
+        self.in_setup = true;
         Ok(())
     }
     fn post_force(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
@@ -533,7 +548,7 @@ impl Fix for WallGranRegion {
         let len = self.slot_len();
         let w = 4 + self.width;
         let col = sim.particles.add_extra(&self.hist_name, vec![0.0; len]);
-        let dt = sim.dt;
+        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
         let p = &mut sim.particles;
         for i in 0..p.len() {
             if p.mask[i] & self.group == 0 {
@@ -669,6 +684,7 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
         hist_name: format!("wall_history:{id}"),
         summary,
         prev: None,
+        in_setup: false,
     }))
 }
 
