@@ -285,3 +285,17 @@ fn meshgran_tutorial_walls_run() {
         assert!(p.x[i].z > -1.22 && p.x[i].y > -0.06 && p.x[i].y < 0.01, "{:?}", p.x[i]);
     }
 }
+
+#[test]
+fn moving_rotating_region_floor_matches_lmp() {
+    // region floor `move v_dx NULL NULL rotate v_th 0 0 0 0 0 1` with
+    // dx = 0.02 t, th = pi t: a sphere resting on it is dragged and bounced
+    // exactly as lmp 29 Sep 2021 does (wall velocity from the region's
+    // displacement and angle differences per step)
+    let got = run_file("in.lmp_region_moving", &[]);
+    let lmp: Vec<Vec<f64>> = reference("ref_lmp_region_moving.txt").into_iter().filter(|r| r[0] > 0.0).collect();
+    assert_eq!(lmp.len(), 20);
+    assert_close(&got, &lmp, 1e-9, "moving region vs lmp");
+    // the sphere was carried along +x by the moving floor
+    assert!(got.last().expect("rows")[2] > 0.0205);
+}

@@ -691,15 +691,14 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
 // ------------------------------------------------------------ dump mesh/stl
 
 /// `dump ID group mesh/stl N file [mesh ids]`: the current (moved) meshes as
-/// ASCII STL; `*` in the file name becomes the step, otherwise frames are
-/// appended to one file.
+/// ASCII STL, one file per frame (`*` in the file name becomes the step;
+/// LIGGGHTS requires the `*`).
 pub struct DumpMeshStl {
     id: String,
     every: i64,
     path: String,
     meshes: Vec<SharedMesh>,
     last_step: Option<i64>,
-    wrote_once: bool,
     summary: String,
 }
 
@@ -720,16 +719,8 @@ impl Dump for DumpMeshStl {
             tris.extend(m.read().map_err(|_| lock_err())?.current_triangles(sim.time));
         }
         let text = crate::io::vtk::format_stl(&tris);
-        let (path, append) = if self.path.contains('*') { (self.path.replace('*', &sim.step.to_string()), false) } else { (self.path.clone(), self.wrote_once) };
-        let r = if append {
-            use std::io::Write;
-            std::fs::OpenOptions::new().append(true).create(true).open(&path).and_then(|mut f| f.write_all(text.as_bytes()))
-        } else {
-            std::fs::write(&path, text)
-        };
-        r.map_err(|e| Error::io(crate::script::Span::DUMMY, format!("dump {}: cannot write '{path}'", self.id), &e))?;
-        self.wrote_once = true;
-        Ok(())
+        let path = self.path.replace('*', &sim.step.to_string());
+        std::fs::write(&path, text).map_err(|e| Error::io(crate::script::Span::DUMMY, format!("dump {}: cannot write '{path}'", self.id), &e))
     }
     fn id(&self) -> &str {
         &self.id
@@ -758,6 +749,9 @@ pub fn dump_mesh_stl(s: &Session, cmd: &Command) -> Result<DumpMeshStl> {
         return Err(a.err_prev("dump mesh/stl: N must be > 0"));
     }
     let file = a.word("file")?;
+    if !file.text.contains('*') {
+        return Err(Error::deck(file.span, "dump mesh/stl: use a file name like 'dump*.stl' (one file per time step, as LIGGGHTS requires)"));
+    }
     let mut meshes = Vec::new();
     let mut names = Vec::new();
     while a.more() {
@@ -774,5 +768,5 @@ pub fn dump_mesh_stl(s: &Session, cmd: &Command) -> Result<DumpMeshStl> {
         }
     }
     let summary = format!("dump {} mesh/stl every {every} -> {} (meshes {})", id.text, file.text, names.join(" "));
-    Ok(DumpMeshStl { id: id.text.clone(), every, path: file.text.clone(), meshes, last_step: None, wrote_once: false, summary })
+    Ok(DumpMeshStl { id: id.text.clone(), every, path: file.text.clone(), meshes, last_step: None, summary })
 }
