@@ -222,15 +222,11 @@ impl SurfaceMesh {
         SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None, moving: false }
     }
 
-    /// Whether every triangle's edge and node neighbours are coplanar with it
-    /// (`mesh/surface/planar`).
+    /// Whether all triangles lie in one plane within the curvature
+    /// tolerance (`mesh/surface/planar`).
     pub fn is_planar(&self) -> bool {
-        let n = self.tris.len();
-        (0..n).all(|t| (0..n).all(|s| s == t || self.coplanar[t].contains(&(s as u32)) || !self.share_node(t, s)))
-    }
-
-    fn share_node(&self, a: usize, b: usize) -> bool {
-        self.tris[a].v.iter().any(|p| self.tris[b].v.iter().any(|q| (p - q).abs().max() <= 1e-8))
+        let Some(t0) = self.tris.first() else { return true };
+        self.tris.iter().all(|t| t.n.dot(&t0.n).abs() >= self.curvature_cos && t0.n.dot(&(t.v[0] - t0.v[0])).abs() <= 1e-8 * (1.0 + t.v[0].norm()))
     }
 
     /// Whether triangles a and b are coplanar neighbours.
