@@ -11,5 +11,6 @@ pub mod output;
 pub mod sim;
 pub mod rng;
 pub mod insert;
+pub mod mesh_surface;
 
 pub use sim::{Dialect, Sim};

@@ -1,13 +1,772 @@
-//! Triangle-mesh walls and region walls: fix mesh/surface, mesh/surface/planar,
-//! move/mesh, wall/gran ... mesh, LAMMPS wall/gran/region. (In progress.)
+//! Triangle-mesh walls and region walls: `fix mesh/surface`,
+//! `mesh/surface/planar`, `move/mesh`, LIGGGHTS `wall/gran ... mesh`, LAMMPS
+//! `wall/gran/region`, and `dump mesh/stl`.
+//!
+//! A mesh lives in its `fix mesh/surface` (the registry is the fix list: see
+//! [`find_mesh`]); walls, movers and dumps hold a [`SharedMesh`] to it. Mesh
+//! walls apply the scene's contact laws through `ContactKernel::contact`
+//! like the primitive walls of `scene/walls.rs`, with the LIGGGHTS
+//! edge/corner activity and duplicate-contact rules of
+//! `engine/mesh_surface.rs`.
 
-use super::args::Args;
+use super::args::{self, Args};
+use super::model::{self, CohesionSpec, NormalSpec, PairSpec, RollingSpec, TangentialSpec};
 use super::Session;
+use crate::engine::fix::Fix;
+use crate::engine::kernel::{ContactKernel, ParamTable};
+use crate::engine::mesh_surface::{resolve_particle, SharedMesh, Slots, SurfaceMesh, DEFAULT_CURVATURE_COS, MESH_SLOTS};
+use crate::engine::output::Dump;
+use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
+use crate::geom::mesh::parse_mesh_transforms;
+use crate::geom::{MeshMotion, Region, Triangle};
+use crate::physics::{Contact, V3};
 use crate::script::{Command, Variables, Word};
+use std::sync::{Arc, RwLock};
 
 /// Parse a mesh- or region-wall fix.
 pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
-    let _ = (s, cmd, id, group, a, vars);
-    Err(Error::unsupported(style.span, format!("fix {}", style.text)))
+    let _ = vars;
+    match style.text.as_str() {
+        "mesh/surface" | "mesh/surface/planar" => mesh_surface(s, cmd, id, style, a),
+        "wall/gran" => wall_gran_mesh(s, cmd, id, group, a),
+        "move/mesh" => move_mesh(s, cmd, id, a),
+        "wall/gran/region" => wall_gran_region(s, cmd, id, group, a),
+        _ => Err(Error::unsupported(style.span, format!("fix {}", style.text))),
+    }
+}
+
+fn lock_err() -> Error {
+    Error::runtime("mesh state poisoned by an earlier failure")
+}
+
+// ---------------------------------------------------------------- registry
+
+/// The fix holding a mesh (`fix mesh/surface`).
+pub struct MeshSurfaceFix {
+    id: String,
+    style: String,
+    /// The mesh.
+    pub mesh: SharedMesh,
+    summary: String,
+}
+
+impl Fix for MeshSurfaceFix {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        &self.style
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+}
+
+/// The mesh of `fix mesh/surface` with id `id`, if defined.
+pub fn find_mesh(s: &Session, id: &str) -> Option<SharedMesh> {
+    s.sim
+        .fixes
+        .iter()
+        .filter(|f| f.id() == id)
+        .find_map(|f| f.as_any().and_then(|a| a.downcast_ref::<MeshSurfaceFix>()).map(|m| m.mesh.clone()))
+}
+
+fn need_mesh(s: &Session, w: &Word) -> Result<SharedMesh> {
+    find_mesh(s, &w.text).ok_or_else(|| {
+        let ids: Vec<&str> = s.sim.fixes.iter().filter(|f| f.style().starts_with("mesh/surface")).map(|f| f.id()).collect();
+        let mut e = Error::deck(w.span, format!("fix mesh/surface '{}' does not exist", w.text));
+        if let Some(h) = crate::error::did_you_mean(&w.text, ids) {
+            e = e.with_hint(format!("did you mean '{h}'?"));
+        }
+        e
+    })
+}
+
+// ---------------------------------------------------------- mesh/surface
+
+fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, style: &Word, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    s.set_dialect(Dialect::Liggghts);
+    let mut file: Option<&Word> = None;
+    let mut wall_type: Option<u32> = None;
+    let mut heal = false;
+    let mut precision = 1e-8;
+    let mut curvature_cos = DEFAULT_CURVATURE_COS;
+    let mut tolerant = false;
+    let mut surface_vel = None;
+    let mut transforms = Vec::new();
+    let words = a.rest();
+    let mut i = 0;
+    let num = |i: usize, what: &str| -> Result<f64> {
+        let w = words.get(i).ok_or_else(|| Error::deck(a.end_span(), format!("fix {}: missing {what}", style.text)))?;
+        args::parse_f64(w)
+    };
+    let word = |i: usize, what: &str| -> Result<&Word> {
+        words.get(i).ok_or_else(|| Error::deck(a.end_span(), format!("fix {}: missing {what}", style.text)))
+    };
+    while i < words.len() {
+        let k = &words[i];
+        match k.text.as_str() {
+            "file" => {
+                file = Some(word(i + 1, "file name")?);
+                i += 2;
+            }
+            "type" => {
+                let w = word(i + 1, "wall type")?;
+                let t = args::parse_i64(w)?;
+                if t < 1 || t as usize > s.sim.ntypes {
+                    return Err(Error::deck(w.span, format!("wall type {t} out of range 1..{}", s.sim.ntypes)));
+                }
+                wall_type = Some(t as u32);
+                i += 2;
+            }
+            "verbose" | "curvature_tolerant" => {
+                let w = word(i + 1, "yes or no")?;
+                let v = match w.text.as_str() {
+                    "yes" => true,
+                    "no" => false,
+                    _ => return Err(args::bad_keyword(w, "value", &["yes", "no"])),
+                };
+                if k.text == "curvature_tolerant" {
+                    tolerant = v;
+                }
+                i += 2;
+            }
+            "heal" => {
+                let w = word(i + 1, "heal mode")?;
+                heal = match w.text.as_str() {
+                    "auto_remove_duplicates" => true,
+                    "no" => false,
+                    _ => return Err(args::bad_keyword(w, "heal mode", &["auto_remove_duplicates", "no"])),
+                };
+                i += 2;
+            }
+            "precision" => {
+                precision = num(i + 1, "precision")?;
+                if precision <= 0.0 {
+                    return Err(Error::deck(words[i + 1].span, "precision must be > 0"));
+                }
+                i += 2;
+            }
+            "curvature" => {
+                let c = num(i + 1, "curvature angle (degrees)")?;
+                if !(0.0..=60.0).contains(&c) {
+                    return Err(Error::deck(words[i + 1].span, "curvature must be between 0 and 60 degrees"));
+                }
+                curvature_cos = (c * std::f64::consts::PI / 180.0).cos();
+                i += 2;
+            }
+            "temperature" | "mass_temperature" => {
+                num(i + 1, &k.text)?;
+                s.notes.push((k.span, format!("fix {}: `{}` accepted; demx has no heat transfer", style.text, k.text)));
+                i += 2;
+            }
+            "surface_vel" => {
+                surface_vel = Some(V3::new(num(i + 1, "vx")?, num(i + 2, "vy")?, num(i + 3, "vz")?));
+                i += 4;
+            }
+            "move" | "rotate" | "scale" => {
+                let n = match k.text.as_str() {
+                    "move" => 4,
+                    "rotate" => 7,
+                    _ => 2,
+                };
+                let end = (i + n).min(words.len());
+                let (t, _) = parse_mesh_transforms(cmd, &words[i..end])?;
+                if t.len() != 1 {
+                    return Err(Error::deck(k.span, format!("fix {}: malformed {}", style.text, k.text)));
+                }
+                transforms.extend(t);
+                i = end;
+            }
+            "region" | "element_exclusion_list" | "min_feature_length" | "surface_ang_vel" | "extrude_planar" | "fix" | "reference_frame" => {
+                return Err(Error::unsupported(k.span, format!("fix {} keyword {}", style.text, k.text)))
+            }
+            _ => {
+                return Err(args::bad_keyword(
+                    k,
+                    &format!("fix {} keyword", style.text),
+                    &["file", "type", "scale", "move", "rotate", "curvature", "heal", "verbose", "precision", "surface_vel", "temperature"],
+                ))
+            }
+        }
+    }
+    a.pos += words.len();
+    let file = file.ok_or_else(|| Error::deck(style.span, format!("fix {}: missing `file F`", style.text)))?;
+    let wall_type = wall_type.ok_or_else(|| Error::deck(style.span, format!("fix {}: missing `type T`", style.text)))?;
+    let raw = crate::geom::read_stl(std::path::Path::new(&file.text), file.span)?;
+    let tris = crate::geom::Mesh::new(raw).transformed(&transforms).tris;
+    // duplicate elements (same three nodes)
+    let mut kept: Vec<Triangle> = Vec::with_capacity(tris.len());
+    let key = |t: &Triangle| {
+        let mut v: Vec<[i64; 3]> = t.v.iter().map(|p| [0, 1, 2].map(|d| (p[d] / precision).round() as i64)).collect();
+        v.sort_unstable();
+        v
+    };
+    let mut seen = std::collections::HashMap::new();
+    for (k, t) in tris.iter().enumerate() {
+        match seen.get(&key(t)) {
+            Some(j) if !heal => {
+                return Err(Error::deck(
+                    file.span,
+                    format!("mesh '{}': elements {j} and {k} are duplicate; bad mesh, cannot continue", file.text),
+                )
+                .with_hint("LIGGGHTS: try re-running with 'heal auto_remove_duplicates'"))
+            }
+            Some(_) => continue,
+            None => {
+                seen.insert(key(t), k);
+                kept.push(*t);
+            }
+        }
+    }
+    if !tolerant {
+        for (k, t) in kept.iter().enumerate() {
+            for c in 0..3 {
+                let (e1, e2) = (t.e[c].normalize(), t.e[(c + 2) % 3].normalize());
+                if -e1.dot(&e2) > curvature_cos {
+                    return Err(Error::deck(
+                        file.span,
+                        format!("mesh '{}': an angle of element {k} is smaller than the curvature angle", file.text),
+                    )
+                    .with_hint("set 'curvature' lower, or 'curvature_tolerant yes'"));
+                }
+            }
+        }
+    }
+    let mut mesh = SurfaceMesh::new(id, wall_type, kept, curvature_cos, precision);
+    mesh.surface_vel = surface_vel;
+    if style.text == "mesh/surface/planar" && !mesh.is_planar() {
+        return Err(Error::deck(file.span, format!("fix mesh/surface/planar: mesh '{}' is not planar", file.text)));
+    }
+    let summary = format!("mesh/surface {id}: {} triangles from {}, type {wall_type}", mesh.tris.len(), file.text);
+    s.add_fix(Box::new(MeshSurfaceFix { id: id.to_string(), style: style.text.clone(), mesh: Arc::new(RwLock::new(mesh)), summary }))
+}
+
+// ---------------------------------------------------------------- move/mesh
+
+/// `fix move/mesh`: sets the motion of a mesh; unfixing it freezes the mesh
+/// where it is.
+pub struct MoveMeshFix {
+    id: String,
+    mesh: SharedMesh,
+    now: f64,
+    started: bool,
+}
+
+impl Fix for MoveMeshFix {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "move/mesh"
+    }
+    fn initial_integrate(&mut self, sim: &mut Sim) {
+        self.now = sim.time;
+        if !self.started {
+            if let Ok(mut m) = self.mesh.write() {
+                m.moving = true;
+            }
+            self.started = true;
+        }
+    }
+}
+
+impl Drop for MoveMeshFix {
+    fn drop(&mut self) {
+        if let Ok(mut m) = self.mesh.write() {
+            m.bake(self.now);
+        }
+    }
+}
+
+fn move_mesh(s: &mut Session, cmd: &Command, id: &str, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    a.choice("keyword", &["mesh"])?;
+    let mw = a.word("mesh id")?;
+    let mesh = need_mesh(s, mw)?;
+    let words = a.rest();
+    let style = words.first().ok_or_else(|| Error::deck(a.end_span(), "fix move/mesh: missing motion style"))?;
+    if !["linear", "rotate"].contains(&style.text.as_str()) {
+        let known = ["linear/variable", "wiggle", "riggle", "rotate/variable", "viblin", "vibrot", "file"];
+        if known.contains(&style.text.as_str()) {
+            return Err(Error::unsupported(style.span, format!("fix move/mesh style {}", style.text)));
+        }
+        return Err(args::bad_keyword(style, "move/mesh style", &["linear", "rotate", "wiggle", "riggle", "viblin", "vibrot"]));
+    }
+    let motion = MeshMotion::parse(cmd, words)?;
+    let used = if style.text == "linear" { 4 } else { 11 };
+    if let Some(w) = words.get(used) {
+        return Err(Error::deck(w.span, format!("fix move/mesh: unexpected '{}'", w.text)));
+    }
+    a.pos += words.len();
+    {
+        let mut m = mesh.write().map_err(|_| lock_err())?;
+        if m.motion.is_some() {
+            return Err(Error::unsupported(style.span, "superposed fix move/mesh motions on one mesh"));
+        }
+        m.motion = Some((motion, s.sim.time));
+    }
+    s.walls.push(format!("move/mesh {id}: mesh {} {:?}", mw.text, motion));
+    let now = s.sim.time;
+    s.add_fix(Box::new(MoveMeshFix { id: id.to_string(), mesh, now, started: false }))
+}
+
+// ---------------------------------------------------------- wall/gran mesh
+
+fn base_spec(cmd: &Command) -> PairSpec {
+    PairSpec {
+        span: cmd.span,
+        normal: NormalSpec::LigHertz,
+        tangential: TangentialSpec::LigNoHistory,
+        cohesion: CohesionSpec::Off,
+        rolling: RollingSpec::Off,
+        tangential_damping: true,
+        limit_damping: false,
+        gran: None,
+        granular: vec![],
+        has_coeff: true,
+    }
+}
+
+struct WallMesh {
+    mesh: SharedMesh,
+    hist_name: String,
+}
+
+/// LIGGGHTS `fix wall/gran ... mesh n_meshes N meshes ...`.
+pub struct WallGranMesh {
+    id: String,
+    group: u32,
+    meshes: Vec<WallMesh>,
+    kernel: Box<dyn ContactKernel>,
+    table: ParamTable,
+    width: usize,
+    summary: String,
+    /// The next post_force is the run setup's: history is not advanced
+    /// (LIGGGHTS/LAMMPS `shearupdate = 0` while `update->setupflag`).
+    in_setup: bool,
+}
+
+impl WallGranMesh {
+    fn slot_len(&self) -> usize {
+        MESH_SLOTS * (1 + self.width)
+    }
+}
+
+impl Fix for WallGranMesh {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "wall/gran"
+    }
+    fn setup(&mut self, sim: &mut Sim) -> Result<()> {
+        for m in &self.meshes {
+            sim.particles.add_extra(&m.hist_name, vec![0.0; self.slot_len()]);
+        }
+        self.in_setup = true;
+        Ok(())
+    }
+    fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
+        let len = self.slot_len();
+        let time = sim.time;
+        // dt = 0 leaves the history where it is (setup force evaluation)
+        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
+        for wm in &self.meshes {
+            let col = sim.particles.add_extra(&wm.hist_name, vec![0.0; len]);
+            let mesh = wm.mesh.read().map_err(|_| lock_err())?;
+            let p = &mut sim.particles;
+            for i in 0..p.len() {
+                if p.mask[i] & self.group == 0 {
+                    continue;
+                }
+                let (xi, ri, vi, wi, mi, kind) = (p.x[i], p.radius[i], p.v[i], p.omega[i], p.mass[i], p.kind[i]);
+                let pref = mesh.to_reference(xi, time);
+                let data = &mut p.extra[col].data[i * len..(i + 1) * len];
+                let pp = self.table.get(kind, mesh.wall_type);
+                let (mut f, mut tq) = (V3::zeros(), V3::zeros());
+                let kernel = &self.kernel;
+                resolve_particle(&mesh, pref, ri, Slots { data, width: self.width }, |hit, hist| {
+                    let n = mesh.dir_to_world(hit.normal, time);
+                    let point = mesh.to_world(hit.point, time);
+                    let vwall = mesh.wall_velocity(point, hit.tri, time);
+                    let vr = vi - vwall;
+                    let c = Contact {
+                        n,
+                        r: ri - hit.delta,
+                        delta: hit.delta,
+                        ri,
+                        rj: f64::INFINITY,
+                        r_eff: ri,
+                        mi,
+                        mj: f64::INFINITY,
+                        m_eff: mi,
+                        vr,
+                        vn: vr.dot(&n),
+                        wi,
+                        wj: V3::zeros(),
+                        dt,
+                    };
+                    let out = kernel.contact(&c, pp, hist);
+                    f += out.force_i(&c);
+                    tq += out.torque_i;
+                })?;
+                p.f[i] += f;
+                p.torque[i] += tq;
+            }
+        }
+        Ok(())
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+}
+
+fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    s.set_dialect(Dialect::Liggghts);
+    let words = a.rest().to_vec();
+    let end = words.iter().position(|w| w.text == "mesh").ok_or_else(|| Error::deck(a.end_span(), "fix wall/gran: missing `mesh n_meshes N meshes ...`"))?;
+    let mut spec = base_spec(cmd);
+    if end > 0 {
+        let model_cmd = Command { words: std::iter::once(cmd.words[0].clone()).chain(words[..end].iter().cloned()).collect(), span: cmd.span };
+        let mut ma = Args::new(&model_cmd);
+        model::parse_liggghts_model(&mut ma, &mut spec)?;
+    }
+    a.pos += end + 1;
+    a.choice("keyword", &["n_meshes"])?;
+    let n = a.i64("number of meshes")?;
+    if n < 1 {
+        return Err(a.err_prev("n_meshes must be >= 1"));
+    }
+    a.choice("keyword", &["meshes"])?;
+    let mut meshes = Vec::new();
+    let mut names = Vec::new();
+    for _ in 0..n {
+        let w = a.word("mesh id")?;
+        let m = need_mesh(s, w)?;
+        meshes.push(WallMesh { mesh: m, hist_name: format!("mesh_history:{id}:{}", w.text) });
+        names.push(w.text.clone());
+    }
+    while a.more() {
+        let k = a.word("keyword")?;
+        match k.text.as_str() {
+            "store_force" | "store_force_contact" | "store_force_contact_stress" => {
+                if a.yes_no(&k.text)? {
+                    return Err(Error::unsupported(k.span, format!("fix wall/gran {} yes", k.text)));
+                }
+            }
+            "meshes" if a.peek().is_some() => {
+                return Err(Error::deck(k.span, format!("fix wall/gran: more mesh ids than n_meshes {n}")));
+            }
+            "shear" | "temperature" | "track_energy" | "contact_area" => {
+                return Err(Error::unsupported(k.span, format!("fix wall/gran keyword {}", k.text)))
+            }
+            _ => {
+                if find_mesh(s, &k.text).is_some() {
+                    return Err(Error::deck(k.span, format!("fix wall/gran: more mesh ids than n_meshes {n}")));
+                }
+                return Err(Error::deck(k.span, format!("fix wall/gran: unknown keyword '{}'", k.text)));
+            }
+        }
+    }
+    let table = model::fill_table(s, &spec, cmd.span)?;
+    let kernel = model::build_kernel(&spec);
+    let width = kernel.history_width();
+    let summary = format!("wall/gran {id} (mesh {}): {}", names.join(" "), spec.summary());
+    s.walls.push(summary.clone());
+    s.add_fix(Box::new(WallGranMesh { id: id.to_string(), group, meshes, kernel, table, width, summary, in_setup: false }))
+}
+
+// ------------------------------------------------------- wall/gran/region
+
+/// Slots per particle of a region wall: `[nx, ny, nz, used, history...]`.
+const REGION_SLOTS: usize = 6;
+
+/// LAMMPS `fix wall/gran/region`.
+pub struct WallGranRegion {
+    id: String,
+    group: u32,
+    region: Region,
+    kernel: Box<dyn ContactKernel>,
+    table: ParamTable,
+    width: usize,
+    hist_name: String,
+    summary: String,
+    /// Displacement and angle at the previous step (wall velocity by differences, as LAMMPS).
+    prev: Option<(i64, V3, f64)>,
+    /// The next post_force is the run setup's (history not advanced).
+    in_setup: bool,
+}
+
+impl WallGranRegion {
+    fn slot_len(&self) -> usize {
+        REGION_SLOTS * (4 + self.width)
+    }
+}
+
+impl Fix for WallGranRegion {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "wall/gran/region"
+    }
+    fn setup(&mut self, sim: &mut Sim) -> Result<()> {
+        sim.particles.add_extra(&self.hist_name, vec![0.0; self.slot_len()]);
+        self.in_setup = true;
+        Ok(())
+    }
+    fn post_force(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        // region position now, and its velocity from the previous step
+        let (mut vmove, mut omega) = (V3::zeros(), 0.0);
+        let mut rot = None;
+        if self.region.is_dynamic() {
+            let ctx: &Sim = sim;
+            let label = format!("fix {} region {}", self.id, self.region.id);
+            self.region.update(sim.time, &|name: &str, _t: f64| {
+                vars.eval_equal(name, ctx).map_err(|e| Error::runtime(format!("{label}: variable {name}: {e}")))
+            })?;
+            let (d, th) = (self.region.disp, self.region.angle);
+            if let Some((step, pd, pth)) = self.prev {
+                if step != sim.step && sim.dt > 0.0 {
+                    let k = (sim.step - step) as f64 * sim.dt;
+                    vmove = (d - pd) / k;
+                    omega = (th - pth) / k;
+                }
+            }
+            self.prev = Some((sim.step, d, th));
+            if let Some((_, pnt, axis)) = self.region.motion.as_ref().and_then(|m| m.rotate.clone()) {
+                rot = Some((pnt + d, axis));
+            }
+        }
+        let len = self.slot_len();
+        let w = 4 + self.width;
+        let col = sim.particles.add_extra(&self.hist_name, vec![0.0; len]);
+        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
+        let p = &mut sim.particles;
+        for i in 0..p.len() {
+            if p.mask[i] & self.group == 0 {
+                continue;
+            }
+            let (xi, ri) = (p.x[i], p.radius[i]);
+            let contacts = self.region.surface_contacts(xi, ri);
+            let data = &mut p.extra[col].data[i * len..(i + 1) * len];
+            let mut used = [false; REGION_SLOTS];
+            let pp = self.table.get(p.kind[i], 1);
+            for sc in contacts {
+                let delta = ri - sc.distance;
+                if delta <= 0.0 {
+                    continue;
+                }
+                let n = sc.normal;
+                // the slot of this face: the stored normal closest to n
+                let mut best: Option<(usize, f64)> = None;
+                for k in 0..REGION_SLOTS {
+                    if data[k * w + 3] != 0.0 && !used[k] {
+                        let d = n.dot(&V3::new(data[k * w], data[k * w + 1], data[k * w + 2]));
+                        if d > 0.5 && best.map_or(true, |(_, b)| d > b) {
+                            best = Some((k, d));
+                        }
+                    }
+                }
+                let k = match best {
+                    Some((k, _)) => k,
+                    None => {
+                        let Some(k) = (0..REGION_SLOTS).find(|&k| data[k * w + 3] == 0.0) else {
+                            return Err(Error::runtime(format!("fix {}: a particle touches more than {REGION_SLOTS} region faces", self.id)));
+                        };
+                        data[k * w + 4..(k + 1) * w].fill(0.0);
+                        k
+                    }
+                };
+                used[k] = true;
+                data[k * w] = n.x;
+                data[k * w + 1] = n.y;
+                data[k * w + 2] = n.z;
+                data[k * w + 3] = 1.0;
+                let mut vwall = vmove;
+                if let Some((c, axis)) = rot {
+                    vwall += (axis * omega).cross(&(sc.point - c));
+                }
+                let mi = p.mass[i];
+                let vr = p.v[i] - vwall;
+                let c = Contact {
+                    n,
+                    r: sc.distance,
+                    delta,
+                    ri,
+                    rj: f64::INFINITY,
+                    r_eff: ri,
+                    mi,
+                    mj: f64::INFINITY,
+                    m_eff: mi,
+                    vr,
+                    vn: vr.dot(&n),
+                    wi: p.omega[i],
+                    wj: V3::zeros(),
+                    dt,
+                };
+                let out = self.kernel.contact(&c, pp, &mut data[k * w + 4..(k + 1) * w]);
+                p.f[i] += out.force_i(&c);
+                p.torque[i] += out.torque_i;
+            }
+            for k in 0..REGION_SLOTS {
+                if !used[k] {
+                    data[k * w..(k + 1) * w].fill(0.0);
+                }
+            }
+        }
+        Ok(())
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+}
+
+fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args) -> Result<()> {
+    s.need_box(cmd)?;
+    s.set_dialect(Dialect::Lammps);
+    let first = a.word("wall style")?;
+    let mut spec = base_spec(cmd);
+    match first.text.as_str() {
+        "hooke" | "hooke/history" | "hertz/history" => {
+            let kn = a.f64("Kn")?;
+            let ktw = a.word("Kt")?;
+            let gn = a.f64("gamma_n")?;
+            let gtw = a.word("gamma_t")?;
+            let xmu = a.f64("xmu")?;
+            let damp = a.i64("dampflag")?;
+            if damp != 0 && damp != 1 {
+                return Err(a.err_prev("dampflag must be 0 or 1"));
+            }
+            let kt = if ktw.text == "NULL" { 2.0 / 7.0 * kn } else { args::parse_f64(ktw)? };
+            let gt = if gtw.text == "NULL" { 0.5 * gn } else { args::parse_f64(gtw)? };
+            if a.peek().map(|w| w.text == "limit_damping").unwrap_or(false) {
+                a.pos += 1;
+                spec.limit_damping = true;
+            }
+            spec.gran = Some([kn, kt, gn, if damp == 0 { 0.0 } else { gt }, xmu]);
+            spec.tangential_damping = damp == 1;
+            spec.normal = if first.text == "hertz/history" { NormalSpec::GranHertz } else { NormalSpec::GranHooke };
+            spec.tangential = if first.text == "hooke" { TangentialSpec::GranNoHistory } else { TangentialSpec::GranHistory };
+        }
+        "granular" => return Err(Error::unsupported(first.span, "fix wall/gran/region granular")),
+        _ => return Err(args::bad_keyword(first, "wall/gran/region style", &["hooke", "hooke/history", "hertz/history", "granular"])),
+    }
+    a.choice("keyword", &["region"])?;
+    let rw = a.word("region id")?;
+    let region = super::setup::region(s, rw)?.clone();
+    while a.more() {
+        let k = a.word("keyword")?;
+        if k.text != "contacts" {
+            return Err(Error::deck(k.span, format!("fix wall/gran/region: unknown keyword '{}'", k.text)));
+        }
+    }
+    spec.has_coeff = true;
+    let table = model::fill_table(s, &spec, cmd.span)?;
+    let kernel = model::build_kernel(&spec);
+    let width = kernel.history_width();
+    let summary = format!("wall/gran/region {id} (region {}): {}", rw.text, spec.summary());
+    s.walls.push(summary.clone());
+    s.add_fix(Box::new(WallGranRegion {
+        id: id.to_string(),
+        group,
+        region,
+        kernel,
+        table,
+        width,
+        hist_name: format!("wall_history:{id}"),
+        summary,
+        prev: None,
+        in_setup: false,
+    }))
+}
+
+// ------------------------------------------------------------ dump mesh/stl
+
+/// `dump ID group mesh/stl N file [mesh ids]`: the current (moved) meshes as
+/// ASCII STL, one file per frame (`*` in the file name becomes the step;
+/// LIGGGHTS requires the `*`).
+pub struct DumpMeshStl {
+    id: String,
+    every: i64,
+    path: String,
+    meshes: Vec<SharedMesh>,
+    last_step: Option<i64>,
+    summary: String,
+}
+
+impl Dump for DumpMeshStl {
+    fn due(&self, step: i64, first: bool) -> bool {
+        if self.last_step == Some(step) {
+            return false;
+        }
+        (self.every > 0 && step % self.every == 0) || first
+    }
+    fn write(&mut self, sim: &Sim) -> Result<()> {
+        if sim.dry {
+            return Ok(());
+        }
+        self.last_step = Some(sim.step);
+        let mut tris = Vec::new();
+        for m in &self.meshes {
+            tris.extend(m.read().map_err(|_| lock_err())?.current_triangles(sim.time));
+        }
+        let text = crate::io::vtk::format_stl(&tris);
+        let path = self.path.replace('*', &sim.step.to_string());
+        std::fs::write(&path, text).map_err(|e| Error::io(crate::script::Span::DUMMY, format!("dump {}: cannot write '{path}'", self.id), &e))
+    }
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn modify(&mut self, args: &[Word]) -> Result<()> {
+        match args.first() {
+            Some(w) => Err(Error::unsupported(w.span, format!("dump_modify {} for dump mesh/stl", w.text))),
+            None => Ok(()),
+        }
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+}
+
+/// Parse `dump ID group mesh/stl N file [mesh ids...]` (all meshes when no id
+/// is given) into a dump; `s.sim.dumps.push(Box::new(...))` is the caller's.
+pub fn dump_mesh_stl(s: &Session, cmd: &Command) -> Result<DumpMeshStl> {
+    let mut a = Args::new(cmd);
+    let id = a.word("dump id")?;
+    let g = a.word("group")?;
+    s.group(g)?;
+    a.choice("dump style", &["mesh/stl"])?;
+    let every = a.i64("N")?;
+    if every <= 0 {
+        return Err(a.err_prev("dump mesh/stl: N must be > 0"));
+    }
+    let file = a.word("file")?;
+    if !file.text.contains('*') {
+        return Err(Error::deck(file.span, "dump mesh/stl: use a file name like 'dump*.stl' (one file per time step, as LIGGGHTS requires)"));
+    }
+    let mut meshes = Vec::new();
+    let mut names = Vec::new();
+    while a.more() {
+        let w = a.word("mesh id")?;
+        meshes.push(need_mesh(s, w)?);
+        names.push(w.text.clone());
+    }
+    if meshes.is_empty() {
+        for f in &s.sim.fixes {
+            if let Some(m) = f.as_any().and_then(|x| x.downcast_ref::<MeshSurfaceFix>()) {
+                meshes.push(m.mesh.clone());
+                names.push(m.id.clone());
+            }
+        }
+    }
+    let summary = format!("dump {} mesh/stl every {every} -> {} (meshes {})", id.text, file.text, names.join(" "));
+    Ok(DumpMeshStl { id: id.text.clone(), every, path: file.text.clone(), meshes, last_step: None, summary })
 }
