@@ -12,6 +12,9 @@ fn run(deck: &str, threads: usize) -> Vec<u8> {
     let out = Command::new(env!("CARGO_BIN_EXE_demx"))
         .current_dir(dir.path())
         .args(["run", "--quiet", "--log", "none", "--threads", &threads.to_string()])
+        // `--threads` is not yet wired to a thread pool (Session::threads is
+        // unused); RAYON_NUM_THREADS sizes rayon's global pool meanwhile.
+        .env("RAYON_NUM_THREADS", threads.to_string())
         .arg(&deck)
         .output()
         .expect("run demx");
