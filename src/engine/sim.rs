@@ -193,6 +193,13 @@ impl Sim {
 
     /// Clear forces and compute pair forces.
     pub fn pair_forces(&mut self) {
+        self.pair_forces_dt(self.dt);
+    }
+
+    /// Clear forces and compute pair forces, advancing contact history by
+    /// `dt` (0 in the setup pass: LAMMPS and LIGGGHTS do not update shear
+    /// history while `update->setupflag` is set).
+    fn pair_forces_dt(&mut self, dt: f64) {
         let p = &mut self.particles;
         for f in p.f.iter_mut() {
             *f = V3::zeros();
@@ -201,7 +208,7 @@ impl Sim {
             *t = V3::zeros();
         }
         if let Some(m) = &self.model {
-            m.kernel.pair_pass(&self.particles, &mut self.pairs, &m.table, self.dt, &mut self.pair_out);
+            m.kernel.pair_pass(&self.particles, &mut self.pairs, &m.table, dt, &mut self.pair_out);
             let p = &mut self.particles;
             gather(&self.pairs, &self.pair_out, &mut p.f, &mut p.torque);
         }
@@ -211,7 +218,7 @@ impl Sim {
     pub fn setup(&mut self, vars: &Variables) -> Result<()> {
         self.each_fix(|f, s| f.setup(s))?;
         self.rebuild()?;
-        self.pair_forces();
+        self.pair_forces_dt(0.0);
         self.each_fix(|f, s| f.post_force(s, vars))?;
         Ok(())
     }
