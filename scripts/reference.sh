@@ -45,7 +45,8 @@ run_one() { # engine case
     echo "cd <tmpdir> && $bin -in in.deck -log log.txt -echo none -screen none   # in.deck = ${deck#$root/}" > "$out/command.txt"
     cp "$deck" "$out/$(basename "$deck")"
     # drop wall-clock lines so reruns only differ where physics differs
-    grep -v -e '^Loop time' -e 'finish time' -e 'Setting up run at' -e '^Memory usage' -e 'Total wall time' "$tmp/log.txt" \
+    grep -v -e '^Loop time' -e 'finish time' -e 'Setting up run at' -e '^Memory usage' -e 'Total wall time' \
+        -e 'CPU' -e '|' -e 'time (%)' -e '^Performance' -e '^Nlocal' -e '^Nghost' -e '^Neighs' -e '^Histogram' "$tmp/log.txt" \
         | gzip -n -9 > "$out/log.gz"
     gzip -n -9 -c "$tmp/dump.$case_" > "$out/dump.gz"
     rm -rf "$tmp"
