@@ -53,6 +53,11 @@ enum Cmd {
         /// Print the summary as JSON.
         #[arg(long)]
         json: bool,
+        /// Check only the script language (variables, loops, includes,
+        /// conditionals): every other command is accepted unexecuted and
+        /// thermo values read as 0.
+        #[arg(long)]
+        script_only: bool,
     },
     /// Dump file tools.
     Dump {
@@ -181,7 +186,25 @@ pub fn main() -> ExitCode {
                 Err(e) => report(&e, &sources),
             }
         }
-        Cmd::Check { mut deck, json } => {
+        Cmd::Check { mut deck, json, script_only: true } => {
+            deck.var_groups = groups.clone();
+            let sources = SourceMap::new();
+            let mut host = ScriptOnly::default();
+            let mut interp = Interpreter::new(sources.clone(), cli_vars(&deck));
+            interp.set_command_limit(2_000_000);
+            match interp.run_file(&deck.deck, &mut host) {
+                Ok(()) => {
+                    if json {
+                        println!("{{\"commands\": {}}}", host.commands);
+                    } else {
+                        println!("script language: ok ({} commands)", host.commands);
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => report(&e, &sources),
+            }
+        }
+        Cmd::Check { mut deck, json, .. } => {
             deck.var_groups = groups.clone();
             let (s, sources, r) = run_deck(&deck, true, 1, None, true);
             match r {
@@ -208,5 +231,40 @@ pub fn main() -> ExitCode {
             eprintln!("error: this subcommand is not implemented yet (see the open issues)");
             ExitCode::from(3)
         }
+    }
+}
+
+/// Host for `demx check --script-only`: accepts every command unexecuted.
+#[derive(Default)]
+struct ScriptOnly {
+    commands: u64,
+}
+
+impl crate::script::EvalContext for ScriptOnly {
+    fn thermo(&self, _name: &str) -> Option<f64> {
+        Some(0.0)
+    }
+    fn compute(&self, _id: &str, _i: Option<usize>, _j: Option<usize>) -> std::result::Result<f64, String> {
+        Ok(0.0)
+    }
+    fn fix(&self, _id: &str, _i: Option<usize>, _j: Option<usize>) -> std::result::Result<f64, String> {
+        Ok(0.0)
+    }
+    fn atom_value(&self, _k: &str, _id: i64) -> std::result::Result<f64, String> {
+        Ok(0.0)
+    }
+    fn group_function(&self, _name: &str, _args: &[&str]) -> std::result::Result<f64, String> {
+        Ok(0.0)
+    }
+}
+
+impl crate::script::Host for ScriptOnly {
+    fn execute(&mut self, _cmd: &crate::script::Command, _vars: &mut crate::script::Variables) -> Result<()> {
+        self.commands += 1;
+        Ok(())
+    }
+    fn output(&mut self, _text: &str) {}
+    fn set_log(&mut self, _path: Option<&str>, _append: bool, _span: crate::script::Span) -> Result<()> {
+        Ok(())
     }
 }

@@ -31,6 +31,11 @@ pub trait Fix: Send {
     fn post_force(&mut self, _sim: &mut Sim, _vars: &Variables) -> Result<()> {
         Ok(())
     }
+    /// Output at the start of a run, after the setup forces (LAMMPS fix
+    /// print prints at the first step of a run when it is a multiple of N).
+    fn setup_output(&mut self, _sim: &mut Sim, _vars: &Variables) -> Result<()> {
+        Ok(())
+    }
     /// Integration, second half.
     fn final_integrate(&mut self, _sim: &mut Sim) {}
     /// End of step (print, ave/time, checks).

@@ -252,6 +252,10 @@ pub fn thermo_keyword(sim: &Sim, k: &str) -> Option<f64> {
         "cpu" => sim.clock.elapsed().as_secs_f64(),
         "atoms" => n,
         "temp" => sim.temperature(),
+        "ke" if sim.dialect == super::sim::Dialect::Liggghts => {
+            // LIGGGHTS: the plain sum of 1/2 m v^2 (also for a single atom)
+            norm(sim.kinetic_energy(u32::MAX))
+        }
         "ke" => {
             // LAMMPS: ke from the temperature (0 when dof <= 0)
             let dim = d.map_or(3.0, |d| d.dimension as f64);

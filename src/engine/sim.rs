@@ -201,6 +201,13 @@ impl Sim {
 
     /// Clear forces and compute pair forces.
     pub fn pair_forces(&mut self) {
+        self.pair_forces_dt(self.dt);
+    }
+
+    /// Clear forces and compute pair forces, advancing contact history by
+    /// `dt` (0 in the setup pass: LAMMPS and LIGGGHTS do not update shear
+    /// history while `update->setupflag` is set).
+    fn pair_forces_dt(&mut self, dt: f64) {
         let p = &mut self.particles;
         for f in p.f.iter_mut() {
             *f = V3::zeros();
@@ -209,7 +216,7 @@ impl Sim {
             *t = V3::zeros();
         }
         if let Some(m) = &self.model {
-            m.kernel.pair_pass(&self.particles, &mut self.pairs, &m.table, self.dt, &mut self.pair_out);
+            m.kernel.pair_pass(&self.particles, &mut self.pairs, &m.table, dt, &mut self.pair_out);
             let p = &mut self.particles;
             gather(&self.pairs, &self.pair_out, &mut p.f, &mut p.torque);
         }
@@ -218,7 +225,8 @@ impl Sim {
     /// Forces at the start of a run (LAMMPS `Verlet::setup`).
     ///
     /// As in LAMMPS (`update->setupflag`), computing the setup forces does not
-    /// advance contact history: pair and wall histories are restored after it.
+    /// advance contact history (dt = 0 for pairs; walls do the same in the
+    /// post_force that follows their `setup`).
     /// After `read_restart` the saved pair list and forces are used as they are.
     pub fn setup(&mut self, vars: &Variables) -> Result<()> {
         self.each_fix(|f, s| f.setup(s))?;
@@ -228,16 +236,9 @@ impl Sim {
         }
         self.resume = false;
         self.rebuild()?;
-        let hist = self.pairs.hist.clone();
-        let extra: Vec<Vec<f64>> = self.particles.extra.iter().map(|e| e.data.clone()).collect();
-        self.pair_forces();
+        self.pair_forces_dt(0.0);
         self.each_fix(|f, s| f.post_force(s, vars))?;
-        self.pairs.hist = hist;
-        for (e, d) in self.particles.extra.iter_mut().zip(extra) {
-            if e.data.len() == d.len() {
-                e.data = d;
-            }
-        }
+        self.each_fix(|f, s| f.setup_output(s, vars))?;
         Ok(())
     }
 

@@ -289,6 +289,12 @@ impl Fix for Print {
     fn style(&self) -> &str {
         "print"
     }
+    fn setup_output(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        if sim.dialect == crate::engine::Dialect::Lammps {
+            self.end_of_step(sim, vars)?;
+        }
+        Ok(())
+    }
     fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
         use std::io::Write;
         if self.every <= 0 || sim.step % self.every != 0 {

@@ -476,7 +476,7 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
         }
     }
     let table = model::fill_table(s, &spec, cmd.span)?;
-    let kernel = model::build_kernel(&spec);
+    let kernel = model::build_kernel(&spec)?;
     let width = kernel.history_width();
     let summary = format!("wall/gran {id} (mesh {}): {}", names.join(" "), spec.summary());
     s.walls.push(summary.clone());
@@ -670,7 +670,7 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
     }
     spec.has_coeff = true;
     let table = model::fill_table(s, &spec, cmd.span)?;
-    let kernel = model::build_kernel(&spec);
+    let kernel = model::build_kernel(&spec)?;
     let width = kernel.history_width();
     let summary = format!("wall/gran/region {id} (region {}): {}", rw.text, spec.summary());
     s.walls.push(summary.clone());

@@ -384,12 +384,19 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             (DumpOptions::custom(engine, every.max(0) as u64, &refs), cols)
         }
         "atom" | "atom/gz" => (DumpOptions::atom(engine, every.max(0) as u64), vec![]),
-        "custom/vtk" | "mesh/stl" | "mesh/vtk" | "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "stl" | "mesh/gran/VTK" | "vtk" | "decomposition/vtk" | "euler/vtk" => {
+        "mesh/stl" => {
+            if s.sim.dumps.iter().any(|x| x.id() == id.text) {
+                return Err(Error::deck(id.span, format!("dump '{}' already exists", id.text)).with_hint("undump it first"));
+            }
+            let d = super::mesh::dump_mesh_stl(s, cmd)?;
+            s.sim.dumps.push(Box::new(d));
+            return Ok(());
+        }
+        "custom/vtk" | "mesh/vtk" | "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "stl" | "mesh/gran/VTK" | "vtk" | "decomposition/vtk" | "euler/vtk" => {
             return Err(Error::unsupported(style.span, format!("dump {}", style.text)));
         }
         _ => return Err(bad_keyword(style, "dump style", &["custom", "atom", "custom/vtk", "mesh/stl"])),
     };
-    let _ = cmd;
     let summary = format!("dump {} {} every {} -> {}", id.text, style.text, every, file.text);
     let d = DumpText { id: id.text.clone(), group, columns, writer: None, opts, path: file.text.clone(), last_step: None, summary };
     if let Some(k) = s.sim.dumps.iter().position(|x| x.id() == id.text) {

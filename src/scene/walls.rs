@@ -29,6 +29,9 @@ pub struct WallGran {
     summary: String,
     /// Time the wall motion started.
     t0: f64,
+    /// The next post_force is the setup force evaluation: history does not
+    /// advance (LAMMPS/LIGGGHTS `update->setupflag`).
+    in_setup: bool,
 }
 
 impl Fix for WallGran {
@@ -40,6 +43,7 @@ impl Fix for WallGran {
     }
     fn setup(&mut self, sim: &mut Sim) -> Result<()> {
         sim.particles.add_extra(&self.hist_name, vec![0.0; self.width.max(1)]);
+        self.in_setup = true;
         Ok(())
     }
     fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
@@ -48,7 +52,7 @@ impl Fix for WallGran {
         let axis = self.wall.axis();
         let shift = self.motion.shift(axis, t);
         let vwall = self.motion.velocity(t);
-        let dt = sim.dt;
+        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
         let p = &mut sim.particles;
         let w = self.width.max(1);
         for i in 0..p.len() {
@@ -213,6 +217,7 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
         hist_name: format!("wall_history:{id}"),
         summary,
         t0,
+        in_setup: false,
     }))
 }
 
