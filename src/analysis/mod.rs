@@ -1,1 +1,8 @@
-//! analysis (in progress).
+//! Measurements on runs: comparison with the reference engines, angle of
+//! repose, packing fraction, aeolian transport, cost-accuracy trade-offs.
+pub mod compare;
+pub mod reference;
+pub mod repose;
+pub mod packing;
+pub mod saltation;
+pub mod tradeoff;

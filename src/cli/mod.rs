@@ -64,24 +64,28 @@ enum Cmd {
         #[command(subcommand)]
         what: DumpCmd,
     },
-    /// Compare demx with LIGGGHTS/LAMMPS (not implemented yet).
-    Compare {
-        /// Inputs.
-        #[arg(num_args = 0..)]
-        inputs: Vec<String>,
-    },
-    /// Run the real engine on a deck (not implemented yet).
-    Reference {
-        /// Inputs.
-        #[arg(num_args = 0..)]
-        inputs: Vec<String>,
-    },
-    /// Convert legacy decks / dialects (not implemented yet).
-    Convert {
-        /// Inputs.
-        #[arg(num_args = 0..)]
-        inputs: Vec<String>,
-    },
+    /// Compare runs: dumps, output folders, or a deck against an engine.
+    Compare(Passthrough),
+    /// Run the real LIGGGHTS/LAMMPS on a deck and collect full-precision results.
+    Reference(Passthrough),
+    /// Convert legacy decks and translate between LIGGGHTS and LAMMPS.
+    Convert(Passthrough),
+    /// Angle of repose of a heap, the paper's way.
+    Repose(Passthrough),
+    /// Packing fraction of a settled column, the paper's way.
+    Packing(Passthrough),
+    /// Aeolian transport measurements over a run's outputs.
+    Saltation(Passthrough),
+    /// What accuracy costs in time: run a deck over settings.
+    Tradeoff(Passthrough),
+}
+
+/// Arguments handed unparsed to a subcommand's own parser.
+#[derive(Args, Debug)]
+pub struct Passthrough {
+    /// Arguments of the subcommand (see `demx SUBCOMMAND --help`).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 0..)]
+    args: Vec<String>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -191,7 +195,7 @@ pub fn main() -> ExitCode {
             let sources = SourceMap::new();
             let mut host = ScriptOnly::default();
             let mut interp = Interpreter::new(sources.clone(), cli_vars(&deck));
-            interp.set_command_limit(2_000_000);
+            interp.set_command_limit(50_000_000);
             match interp.run_file(&deck.deck, &mut host) {
                 Ok(()) => {
                     if json {
@@ -227,10 +231,13 @@ pub fn main() -> ExitCode {
             }
             Err(e) => report(&e, &SourceMap::new()),
         },
-        Cmd::Compare { .. } | Cmd::Reference { .. } | Cmd::Convert { .. } => {
-            eprintln!("error: this subcommand is not implemented yet (see the open issues)");
-            ExitCode::from(3)
-        }
+        Cmd::Compare(p) => crate::analysis::compare::cli(p.args),
+        Cmd::Reference(p) => crate::analysis::reference::cli(p.args),
+        Cmd::Convert(p) => crate::convert::cli(p.args),
+        Cmd::Repose(p) => crate::analysis::repose::cli(p.args),
+        Cmd::Packing(p) => crate::analysis::packing::cli(p.args),
+        Cmd::Saltation(p) => crate::analysis::saltation::cli(p.args),
+        Cmd::Tradeoff(p) => crate::analysis::tradeoff::cli(p.args),
     }
 }
 

@@ -71,6 +71,8 @@ pub struct Session {
     pub dialect_known: bool,
     /// `hard_particles yes` (LIGGGHTS: moduli above 1 GPa allowed).
     pub hard_particles: bool,
+    /// `soft_particles yes` (LIGGGHTS: moduli below 5 MPa allowed).
+    pub soft_particles: bool,
     /// Check mode: validate, do not integrate.
     pub check: bool,
     /// Number of threads asked for (for notes only).
@@ -155,6 +157,7 @@ impl Session {
             schedule: vec![],
             dialect_known: false,
             hard_particles: false,
+            soft_particles: false,
             check,
             threads: 1,
             walls: vec![],

@@ -699,7 +699,7 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                         .with_hint("add `hard_particles yes` before the pair_style"));
                 }
             }
-            let settings = LiggghtsSettings { tangential_damping: spec.tangential_damping, limit_force: spec.limit_damping, units_si: s.units == super::Units::Si };
+            let settings = LiggghtsSettings { tangential_damping: spec.tangential_damping, limit_force: spec.limit_damping, units_si: s.units == super::Units::Si && !s.soft_particles };
             let table = liggghts_pair_params(&m, &settings, span)?;
             for i in 1..=nt {
                 for j in 1..=nt {

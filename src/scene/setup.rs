@@ -145,6 +145,8 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             let on = a.yes_no(cmd.name())?;
             if cmd.name() == "hard_particles" {
                 s.hard_particles = on;
+            } else {
+                s.soft_particles = on;
             }
             Ok(())
         }
