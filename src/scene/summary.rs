@@ -34,6 +34,123 @@ pub struct Summary {
     pub outputs: Vec<String>,
     /// Notes on accepted no-op commands.
     pub notes: Vec<String>,
+    /// The time step against the Rayleigh and Hertz times.
+    pub timestep_check: Option<TimestepCheck>,
+    /// Warnings (time step too large, ...).
+    pub warnings: Vec<String>,
+}
+
+/// Time step criteria as LIGGGHTS `fix check/timestep/gran` computes them,
+/// for the stiffest/smallest particle of the scene.
+#[derive(Serialize, Debug, Clone)]
+pub struct TimestepCheck {
+    /// Rayleigh time pi R sqrt(rho/G) / (0.1631 nu + 0.8766).
+    pub rayleigh_time: f64,
+    /// Hertz collision time 2.87 (m*^2 / (R* E*^2 v))^(1/5) of two equal
+    /// spheres at speed `v` (linear spring: pi sqrt(m*/kn)).
+    pub hertz_time: f64,
+    /// Impact speed used for the Hertz time.
+    pub impact_speed: f64,
+    /// dt / rayleigh_time.
+    pub fraction_rayleigh: f64,
+    /// dt / hertz_time.
+    pub fraction_hertz: f64,
+    /// Radius (m) and density of the particle that sets the criteria.
+    pub particle: (f64, f64),
+}
+
+/// demx warns when the time step is above this fraction of the Rayleigh or
+/// the Hertz time (LIGGGHTS tutorials use 0.1-0.2; above 0.2 restitution and
+/// overlaps degrade quickly).
+pub const TIMESTEP_WARN_FRACTION: f64 = 0.2;
+
+/// The particle sizes and densities the scene holds or will insert, by type.
+fn particle_kinds(s: &Session) -> Vec<(u32, f64, f64)> {
+    let mut out = vec![];
+    let p = &s.sim.particles;
+    for i in 0..p.len() {
+        if !out.iter().any(|&(t, r, _)| t == p.kind[i] && r <= p.radius[i]) {
+            out.retain(|&(t, _, _)| t != p.kind[i]);
+            out.push((p.kind[i], p.radius[i], p.density[i]));
+        }
+    }
+    for f in &s.sim.fixes {
+        if let Some(t) = f.as_any().and_then(|a| a.downcast_ref::<crate::scene::insert::Template>()) {
+            out.push((t.kind, t.radius, t.density));
+        }
+    }
+    out
+}
+
+/// Compute the time step criteria of a scene, if it has a contact model and
+/// particles (present or to be inserted).
+pub fn timestep_check(s: &Session) -> Option<TimestepCheck> {
+    use crate::scene::model::NormalSpec;
+    let spec = s.pair.as_ref()?;
+    let kinds = particle_kinds(s);
+    if kinds.is_empty() {
+        return None;
+    }
+    let dt = s.sim.dt;
+    // impact speed: the fastest particle, or free fall over the box height
+    let vmax = s.sim.particles.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let g = s
+        .sim
+        .fixes
+        .iter()
+        .filter_map(|f| f.as_any().and_then(|a| a.downcast_ref::<crate::scene::fixes::Gravity>()))
+        .map(|g| g.acc.norm())
+        .fold(0.0, f64::max);
+    let h = s.sim.domain.as_ref().map_or(0.0, |d| d.len(2));
+    let v = vmax.max((2.0 * g * h).sqrt()).max(1e-3);
+    let per_type = |name: &str, t: u32| s.props.get(name).and_then(|(_, v)| v.get(t as usize - 1).copied());
+    let mut best: Option<TimestepCheck> = None;
+    for (t, r, rho) in kinds {
+        let (y, nu) = match spec.normal {
+            NormalSpec::LigHertz | NormalSpec::LigHooke { .. } => (per_type("youngsModulus", t)?, per_type("poissonsRatio", t)?),
+            NormalSpec::Granular(..) => {
+                let pp = spec.granular.iter().find(|(i, j, _)| *i == t && *j == t).map(|x| x.2)?;
+                if pp.poisson > 0.0 {
+                    // y_eff = E / (2 (1 - nu^2)) for identical materials
+                    (pp.y_eff * 2.0 * (1.0 - pp.poisson * pp.poisson), pp.poisson)
+                } else {
+                    (0.0, 0.0)
+                }
+            }
+            NormalSpec::GranHertz => {
+                // Kn = 4/3 E* with E* = Y / (2 (1 - nu^2)); take nu = 0.3
+                let kn = spec.gran.map(|g| g[0])?;
+                (0.75 * kn * 2.0 * (1.0 - 0.09), 0.3)
+            }
+            _ => (0.0, 0.0),
+        };
+        let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * rho;
+        let m_eff = 0.5 * m;
+        let (tr, th) = if y > 0.0 {
+            let gmod = y / (2.0 * (1.0 + nu));
+            let tr = std::f64::consts::PI * r * (rho / gmod).sqrt() / (0.1631 * nu + 0.8766);
+            let e_eff = y / (2.0 * (1.0 - nu * nu));
+            let r_eff = 0.5 * r;
+            let th = 2.87 * (m_eff * m_eff / (r_eff * e_eff * e_eff * v)).powf(0.2);
+            (tr, th)
+        } else {
+            // linear spring: contact time pi sqrt(m*/kn) (undamped)
+            let kn = match spec.normal {
+                NormalSpec::GranHooke => spec.gran.map(|g| g[0]).unwrap_or(0.0),
+                _ => s.props.get("kn").and_then(|(_, v)| v.get(1).copied()).unwrap_or(0.0),
+            };
+            if kn <= 0.0 {
+                continue;
+            }
+            let tc = std::f64::consts::PI * (m_eff / kn).sqrt();
+            (tc, tc)
+        };
+        let c = TimestepCheck { rayleigh_time: tr, hertz_time: th, impact_speed: v, fraction_rayleigh: dt / tr, fraction_hertz: dt / th, particle: (r, rho) };
+        if best.as_ref().map_or(true, |b| c.fraction_rayleigh.max(c.fraction_hertz) > b.fraction_rayleigh.max(b.fraction_hertz)) {
+            best = Some(c);
+        }
+    }
+    best
 }
 
 impl Summary {
@@ -61,7 +178,28 @@ impl Summary {
             timestep: s.sim.dt,
             outputs,
             notes: s.notes.iter().map(|(_, n)| n.clone()).collect(),
+            timestep_check: timestep_check(s),
+            warnings: vec![],
         }
+        .with_warnings()
+    }
+
+    fn with_warnings(mut self) -> Summary {
+        if let Some(t) = &self.timestep_check {
+            if t.fraction_rayleigh > TIMESTEP_WARN_FRACTION || t.fraction_hertz > TIMESTEP_WARN_FRACTION {
+                self.warnings.push(format!(
+                    "time step {} is {:.0}% of the Rayleigh time and {:.0}% of the Hertz time (warning above {:.0}%): contacts may be resolved badly",
+                    self.timestep,
+                    100.0 * t.fraction_rayleigh,
+                    100.0 * t.fraction_hertz,
+                    100.0 * TIMESTEP_WARN_FRACTION
+                ));
+            }
+        }
+        if self.contact.contains("viscoelastic") || self.contact.contains("vdw") || self.contact.contains("paper") {
+            self.notes.push("this deck uses demx-only contact models (the paper's): it runs in demx only".into());
+        }
+        self
     }
     /// Human-readable text.
     pub fn render(&self) -> String {
@@ -84,6 +222,21 @@ impl Summary {
             o.push_str(&format!("fix: {f}\n"));
         }
         o.push_str(&format!("timestep: {}   runs: {:?} ({} steps)\n", self.timestep, self.runs, self.total_steps));
+        if let Some(t) = &self.timestep_check {
+            o.push_str(&format!(
+                "timestep check: {:.1}% of Rayleigh time {:.3e} s, {:.1}% of Hertz time {:.3e} s (impact speed {:.3} m/s; radius {:.3e}, density {})\n",
+                100.0 * t.fraction_rayleigh,
+                t.rayleigh_time,
+                100.0 * t.fraction_hertz,
+                t.hertz_time,
+                t.impact_speed,
+                t.particle.0,
+                t.particle.1
+            ));
+        }
+        for w in &self.warnings {
+            o.push_str(&format!("warning: {w}\n"));
+        }
         for out in &self.outputs {
             o.push_str(&format!("output: {out}\n"));
         }
