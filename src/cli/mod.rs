@@ -45,6 +45,9 @@ enum Cmd {
         /// No thermo output on the screen.
         #[arg(long)]
         quiet: bool,
+        /// Run at most this many steps per `run` command (smoke tests).
+        #[arg(long)]
+        max_steps: Option<i64>,
     },
     /// Read and validate a deck without running it; print a summary.
     Check {
@@ -140,10 +143,11 @@ fn normalise_args(args: Vec<String>) -> Vec<String> {
 
 /// Run a deck in a session; returns the session (for summaries) or the error
 /// with the source map to render it.
-pub fn run_deck(deck: &DeckArgs, check: bool, threads: usize, log: Option<&str>, quiet: bool) -> (Session, SourceMap, Result<()>) {
+pub fn run_deck(deck: &DeckArgs, check: bool, threads: usize, log: Option<&str>, quiet: bool, max_steps: Option<i64>) -> (Session, SourceMap, Result<()>) {
     let sources = SourceMap::new();
     let mut session = Session::new(check);
     session.threads = threads;
+    session.max_steps = max_steps;
     if check || quiet {
         session.sim.log.screen = false;
     }
@@ -178,13 +182,13 @@ pub fn main() -> ExitCode {
         }
     };
     match cli.cmd {
-        Cmd::Run { mut deck, threads, log, quiet } => {
+        Cmd::Run { mut deck, threads, log, quiet, max_steps } => {
             deck.var_groups = groups.clone();
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build_global();
             if pool.is_err() {
                 eprintln!("warning: thread pool already initialised");
             }
-            let (_s, sources, r) = run_deck(&deck, false, threads, Some(&log), quiet);
+            let (_s, sources, r) = run_deck(&deck, false, threads, Some(&log), quiet, max_steps);
             match r {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => report(&e, &sources),
@@ -210,7 +214,7 @@ pub fn main() -> ExitCode {
         }
         Cmd::Check { mut deck, json, .. } => {
             deck.var_groups = groups.clone();
-            let (s, sources, r) = run_deck(&deck, true, 1, None, true);
+            let (s, sources, r) = run_deck(&deck, true, 1, None, true, None);
             match r {
                 Ok(()) => {
                     let sum = Summary::of(&s);

@@ -77,6 +77,8 @@ pub struct Session {
     pub check: bool,
     /// Number of threads asked for (for notes only).
     pub threads: usize,
+    /// Cap on the steps of every `run` command (`demx run --max-steps`).
+    pub max_steps: Option<i64>,
     /// Wall descriptions for the summary.
     pub walls: Vec<String>,
     /// Particle sources for the summary.
@@ -160,6 +162,7 @@ impl Session {
             soft_particles: false,
             check,
             threads: 1,
+            max_steps: None,
             walls: vec![],
             sources: vec![],
             replay: vec![],
@@ -282,7 +285,10 @@ impl Session {
                 _ => return Err(Error::deck(k.span, "run ... every is handled by the interpreter; this form is malformed")),
             }
         }
-        let steps = if upto { n - self.sim.step } else { n };
+        let mut steps = if upto { n - self.sim.step } else { n };
+        if let Some(m) = self.max_steps {
+            steps = steps.min(m);
+        }
         if steps < 0 {
             return Err(Error::deck(cmd.args()[0].span, "run upto: target step is before the current step"));
         }
