@@ -176,6 +176,13 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             let j = b[k] as usize;
             let xj = p.x[j] + shift[k];
             let pp = table.get(p.kind[i], p.kind[j]);
+            // most listed pairs are within the skin but apart: decide on r^2
+            // before building the contact
+            let reach = p.radius[i] + p.radius[j] + if C::NONCONTACT { pp.extra_range } else { 0.0 };
+            if (p.x[i] - xj).norm_squared() >= reach * reach {
+                hist.fill(0.0);
+                return;
+            }
             let Some((c, _)) = pair_contact(p, i, j, xj, dt) else { return };
             if c.delta <= -pp.extra_range || (c.delta <= 0.0 && !C::NONCONTACT) {
                 hist.fill(0.0);

@@ -356,6 +356,7 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
             Box::new(Gravity { id, group, acc: dir * m, magnitude, dir })
         }
         "freeze" => Box::new(Freeze { id, group, removed: V3::zeros() }),
+        "ave/time" => Box::new(parse_ave_time(&id, a, sim.dry)?),
         "addforce" | "setforce" => {
             let comp = [component(a, "fx")?, component(a, "fy")?, component(a, "fz")?];
             while a.more() {
@@ -414,3 +415,151 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
     }))
 }
 
+
+/// `fix ID group ave/time Nevery Nrepeat Nfreq value ... [ave one|running]
+/// [file F] [start S] [mode scalar]`: time averages of global scalars
+/// (`c_ID`, `c_ID[i]`, `f_ID`, `f_ID[i]`, `v_name`), written every Nfreq steps
+/// in LAMMPS' file layout and readable as `f_ID` / `f_ID[i]`.
+pub struct AveTime {
+    /// Id.
+    pub id: String,
+    nevery: i64,
+    nrepeat: i64,
+    nfreq: i64,
+    values: Vec<String>,
+    running: bool,
+    start: i64,
+    file: Option<std::fs::File>,
+    sums: Vec<f64>,
+    count: i64,
+    /// Last completed averages.
+    result: Vec<f64>,
+    /// Running totals over all windows (`ave running`).
+    total: Vec<f64>,
+    windows: i64,
+    header_written: bool,
+}
+
+impl AveTime {
+    fn sample(&self, sim: &Sim, vars: &Variables) -> Result<Vec<f64>> {
+        self.values.iter().map(|v| crate::engine::output::thermo_value(sim, vars, v)).collect()
+    }
+}
+
+impl Fix for AveTime {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "ave/time"
+    }
+    fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        use std::io::Write;
+        let step = sim.step;
+        if step < self.start {
+            return Ok(());
+        }
+        // the window of output step s samples s - (Nrepeat-1) Nevery ... s
+        let next_out = ((step + self.nfreq - 1) / self.nfreq) * self.nfreq;
+        let first = next_out - (self.nrepeat - 1) * self.nevery;
+        if step < first || (step - first) % self.nevery != 0 {
+            return Ok(());
+        }
+        let vals = self.sample(sim, vars)?;
+        if self.sums.len() != vals.len() {
+            self.sums = vec![0.0; vals.len()];
+        }
+        for (s, v) in self.sums.iter_mut().zip(&vals) {
+            *s += v;
+        }
+        self.count += 1;
+        if step == next_out {
+            let avg: Vec<f64> = self.sums.iter().map(|s| s / self.count as f64).collect();
+            self.sums.iter_mut().for_each(|s| *s = 0.0);
+            self.count = 0;
+            if self.running {
+                if self.total.len() != avg.len() {
+                    self.total = vec![0.0; avg.len()];
+                }
+                for (t, a) in self.total.iter_mut().zip(&avg) {
+                    *t += a;
+                }
+                self.windows += 1;
+                self.result = self.total.iter().map(|t| t / self.windows as f64).collect();
+            } else {
+                self.result = avg;
+            }
+            if let Some(f) = &mut self.file {
+                if !self.header_written {
+                    let _ = writeln!(f, "# Time-averaged data for fix {}\n# TimeStep {}", self.id, self.values.join(" "));
+                    self.header_written = true;
+                }
+                let line: Vec<String> = self.result.iter().map(|v| crate::io::cfmt::fmt_g(*v, 6)).collect();
+                let _ = writeln!(f, "{} {}", step, line.join(" "));
+                let _ = f.flush();
+            }
+        }
+        Ok(())
+    }
+    fn scalar(&self, _sim: &Sim) -> Option<f64> {
+        (self.values.len() == 1).then(|| self.result.first().copied().unwrap_or(0.0))
+    }
+    fn vector(&self, _sim: &Sim, i: usize) -> Option<f64> {
+        (i >= 1 && i <= self.values.len()).then(|| self.result.get(i - 1).copied().unwrap_or(0.0))
+    }
+}
+
+/// Parse `fix ave/time`.
+pub fn parse_ave_time(id: &str, a: &mut Args, check: bool) -> Result<AveTime> {
+    let nevery = a.i64("Nevery")?;
+    let nrepeat = a.i64("Nrepeat")?;
+    let nfreq = a.i64("Nfreq")?;
+    if nevery <= 0 || nrepeat <= 0 || nfreq <= 0 || nfreq % nevery != 0 || (nrepeat - 1) * nevery >= nfreq + nevery {
+        return Err(a.err_prev("fix ave/time: illegal Nevery/Nrepeat/Nfreq (Nfreq must be a multiple of Nevery and Nrepeat*Nevery <= Nfreq)"));
+    }
+    let mut values = vec![];
+    let mut running = false;
+    let mut start = 0;
+    let mut file = None;
+    while a.more() {
+        let w = a.word("value or keyword")?;
+        let t = w.text.as_str();
+        if t.starts_with("c_") || t.starts_with("f_") || t.starts_with("v_") {
+            values.push(t.to_string());
+            continue;
+        }
+        match t {
+            "ave" => {
+                let m = a.choice("ave mode", &["one", "running", "window"])?;
+                match m.text.as_str() {
+                    "running" => running = true,
+                    "window" => return Err(Error::unsupported(m.span, "fix ave/time ave window")),
+                    _ => {}
+                }
+            }
+            "file" => {
+                let f = a.word("file")?;
+                if !check {
+                    file = Some(std::fs::File::create(&f.text).map_err(|e| Error::io(f.span, format!("cannot open '{}'", f.text), &e))?);
+                }
+            }
+            "start" => start = a.i64("start")?,
+            "mode" => {
+                let m = a.choice("mode", &["scalar", "vector"])?;
+                if m.text == "vector" {
+                    return Err(Error::unsupported(m.span, "fix ave/time mode vector"));
+                }
+            }
+            "off" | "overwrite" | "title1" | "title2" | "title3" | "format" => {
+                if t != "overwrite" {
+                    a.word("value")?;
+                }
+            }
+            _ => return Err(Error::deck(w.span, format!("fix ave/time: unknown value or keyword '{t}'")).with_hint("values are c_ID, c_ID[i], f_ID, f_ID[i] or v_name")),
+        }
+    }
+    if values.is_empty() {
+        return Err(Error::deck(a.end_span(), "fix ave/time: no values"));
+    }
+    Ok(AveTime { id: id.to_string(), nevery, nrepeat, nfreq, values, running, start, file, sums: vec![], count: 0, result: vec![], total: vec![], windows: 0, header_written: false })
+}
