@@ -38,6 +38,32 @@ pub fn final_integrate(p: &mut Particles, group: u32, dt: f64) {
     }
 }
 
+/// `fix nve` first half: translation only (LAMMPS `FixNVE`); angular
+/// velocity is left alone, so particles integrated this way do not rotate.
+pub fn initial_integrate_nve(p: &mut Particles, group: u32, dt: f64) {
+    let dtf = 0.5 * dt;
+    for i in 0..p.len() {
+        if p.mask[i] & group == 0 {
+            continue;
+        }
+        let dtfm = dtf / p.mass[i];
+        p.v[i] += p.f[i] * dtfm;
+        p.x[i] += p.v[i] * dt;
+    }
+}
+
+/// `fix nve` second half.
+pub fn final_integrate_nve(p: &mut Particles, group: u32, dt: f64) {
+    let dtf = 0.5 * dt;
+    for i in 0..p.len() {
+        if p.mask[i] & group == 0 {
+            continue;
+        }
+        let dtfm = dtf / p.mass[i];
+        p.v[i] += p.f[i] * dtfm;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

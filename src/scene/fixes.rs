@@ -35,6 +35,32 @@ impl Fix for NveSphere {
     }
 }
 
+/// `fix ID group nve`: translation only (the particles do not rotate).
+pub struct Nve {
+    /// Id.
+    pub id: String,
+    /// Group bit.
+    pub group: u32,
+}
+
+impl Fix for Nve {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "nve"
+    }
+    fn initial_integrate(&mut self, sim: &mut Sim) {
+        integrate::initial_integrate_nve(&mut sim.particles, self.group, sim.dt);
+    }
+    fn final_integrate(&mut self, sim: &mut Sim) {
+        integrate::final_integrate_nve(&mut sim.particles, self.group, sim.dt);
+    }
+    fn integrates(&self) -> bool {
+        true
+    }
+}
+
 /// `fix ID group gravity magnitude vector x y z` (also `spherical`, `chute`).
 pub struct Gravity {
     /// Id.
@@ -356,6 +382,7 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
             Box::new(Gravity { id, group, acc: dir * m, magnitude, dir })
         }
         "freeze" => Box::new(Freeze { id, group, removed: V3::zeros() }),
+        "nve" => Box::new(Nve { id, group }),
         "ave/time" => Box::new(parse_ave_time(&id, a, sim.dry)?),
         "addforce" | "setforce" => {
             let comp = [component(a, "fx")?, component(a, "fy")?, component(a, "fz")?];

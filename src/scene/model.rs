@@ -779,7 +779,7 @@ pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: 
                 "particletemplate/multisphere", "massflow/mesh", "ave/euler", "property/atom/tracer", "wall/region/sph",
                 "insert/pack/dense", "nve/sphere/omp", "ave/chunk", "ave/atom", "deform", "rigid", "spring", "langevin", "nvt", "npt",
                 "wall/reflect", "wall/region", "store/state", "ave/histo", "heat/flow", "temp/rescale", "balance", "dt/reset",
-                "adapt", "python/invoke", "wiggle/mesh", "mesh/gran", "nve", "recenter", "setforce/region", "lineforce", "planeforce",
+                "adapt", "python/invoke", "wiggle/mesh", "mesh/gran", "recenter", "setforce/region", "lineforce", "planeforce",
                 "efield", "wall/lj93",
             ];
             if lig.contains(&other) || other.contains('/') {
