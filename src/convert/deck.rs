@@ -199,6 +199,12 @@ pub struct Facts {
     pub has_newton_off: bool,
     /// LAMMPS `comm_modify` with vel yes seen.
     pub has_comm: bool,
+    /// The deck inserts particles (insert/*, pour).
+    pub has_insertion: bool,
+    /// The deck changes radii with fix adapt.
+    pub has_adapt: bool,
+    /// IDs of all fixes the deck defines.
+    pub fix_ids: std::collections::HashSet<String>,
 }
 
 impl Facts {
@@ -228,7 +234,7 @@ impl Facts {
                 "timestep" if w.len() >= 2 => f.dt = f.num(&w[1]),
                 "newton" if w.len() >= 2 => f.has_newton_off = w[1] == "off",
                 "comm_modify" | "communicate" => f.has_comm = true,
-                "fix" if w.len() >= 4 => match w[3].as_str() {
+                "fix" if w.len() >= 4 => match (f.fix_ids.insert(w[1].clone()), w[3].as_str()).1 {
                     "property/global" if w.len() >= 6 => {
                         let style = w[5].clone();
                         let mut values = w[6..].to_vec();
@@ -240,6 +246,8 @@ impl Facts {
                         f.props.insert(w[4].clone(), Property { id: w[1].clone(), style, values });
                     }
                     "gravity" if w.len() >= 5 => f.gravity = f.num(&w[4]),
+                    s if s.starts_with("insert/") || s.starts_with("pour") => f.has_insertion = true,
+                    "adapt" => f.has_adapt = true,
                     "particletemplate/sphere" => {
                         let get = |k: &str| w.iter().position(|x| x == k).and_then(|i| w.get(i + 2)).cloned();
                         let ty = w.iter().position(|x| x == "atom_type").and_then(|i| w.get(i + 1)).cloned();

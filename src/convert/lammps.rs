@@ -216,6 +216,10 @@ pub fn pair_style_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     if !other.is_empty() {
         ctx.note(Severity::Approx, format!("model keywords '{}' dropped", other.join(" ")));
     }
+    if !matches!(m.normal.as_str(), "hertz" | "hooke/stiffness" | "hertz/stiffness") {
+        ctx.pair_dropped = true;
+        return Some(Action::Drop(format!("model {} has no LAMMPS counterpart with the same law (LIGGGHTS hooke derives kn from characteristicVelocity and each pair's mass and radius)", m.normal), Severity::Dropped));
+    }
     drop_model_axes(ctx, &m);
     let line = if let Some(s) = classic_style(ctx, &m) {
         ctx.pair_done = true;
@@ -232,6 +236,9 @@ pub fn pair_style_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
 
 /// `pair_coeff * *` after a converted 3.x pair_style.
 pub fn pair_coeff_to_lammps(ctx: &mut Ctx, _w: &[String]) -> Option<Action> {
+    if ctx.pair_dropped {
+        return Some(Action::Drop("belongs to the dropped pair_style".into(), Severity::Info));
+    }
     let m = ctx.model.take()?;
     if ctx.pair_done {
         ctx.pair_done = false;
@@ -318,6 +325,7 @@ pub fn wall_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     drop_model_axes(ctx, &m);
     let coeffs = match wall_coeffs(ctx, &m, t) {
         Some(c) => c,
+        None if ctx.pair_dropped => return Some(Action::Drop("the pair model was dropped; its wall goes too".into(), Severity::Dropped)),
         None => return Some(Action::Drop(format!("wall model {} or its material properties not convertible", m.normal), Severity::Dropped)),
     };
     let line = match geom {
@@ -659,4 +667,42 @@ pub fn pour_to_liggghts(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
         return None;
     }
     legacy::pour_to_insert(ctx, w)
+}
+
+/// Old `fix pour` syntax (`diam [uniform] lo hi`, `dens uniform`, `vel
+/// uniform`; LIGGGHTS 1.x and LAMMPS before 2013) -> LAMMPS 2021 syntax.
+pub fn pour_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if !matches!(w.get(3)?.as_str(), "pour" | "pour/legacy") {
+        return None;
+    }
+    let Some(p) = legacy::parse_pour(w) else {
+        return Some(Action::Drop("fix pour arguments not understood".into(), Severity::Dropped));
+    };
+    if ctx.facts.gravity.is_none() {
+        return Some(Action::Drop("LAMMPS fix pour needs fix gravity".into(), Severity::Dropped));
+    }
+    let mut s = format!("fix {} {} pour {} {} {} region {}", w[1], w[2], p.n, p.ty, p.seed, p.region);
+    if let Some((lo, hi)) = &p.diam_range {
+        if lo == hi {
+            s += &format!(" diam one {lo}");
+        } else {
+            s += &format!(" diam range {lo} {hi}");
+        }
+    } else if !p.poly.is_empty() {
+        let parts: Vec<String> = p.poly.iter().map(|(d, q)| format!("{d} {q}")).collect();
+        s += &format!(" diam poly {} {}", p.poly.len(), parts.join(" "));
+    }
+    if let Some((lo, hi)) = &p.dens {
+        s += &format!(" dens {lo} {hi}");
+    }
+    if let Some((f, n)) = &p.vol {
+        s += &format!(" vol {f} {n}");
+    }
+    if p.vel.len() == 5 {
+        s += &format!(" vel {}", p.vel.join(" "));
+    }
+    if !p.other.is_empty() {
+        ctx.note(Severity::Approx, format!("pour words '{}' dropped", p.other.join(" ")));
+    }
+    Some(Action::Replace(vec![s]))
 }

@@ -105,6 +105,7 @@ pub struct Ctx<'a> {
     model: Option<lammps::Model3>,
     wall_model: Option<lammps::Model3>,
     pair_done: bool,
+    pair_dropped: bool,
     granular: bool,
     liggghts_walls: Option<(String, String)>,
 }
@@ -121,6 +122,7 @@ impl<'a> Ctx<'a> {
             model: None,
             wall_model: None,
             pair_done: false,
+            pair_dropped: false,
             granular: false,
             liggghts_walls: None,
         }
@@ -205,13 +207,17 @@ const MATERIALS: &[&str] = &[
 
 /// References to dropped fixes (`f_ID`, `f_ID[i]`).
 fn refs_dropped(ctx: &Ctx, word: &str) -> bool {
-    word.strip_prefix("f_").map(|r| r.split('[').next().unwrap_or(r)).is_some_and(|id| ctx.dropped_fixes.contains(id))
+    word.strip_prefix("f_").map(|r| r.split('[').next().unwrap_or(r)).is_some_and(|id| ctx.dropped_fixes.contains(id) || !ctx.facts.fix_ids.contains(id))
 }
 
 /// 3.x -> LAMMPS rules for one command.
 fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
     let r = match w[0].as_str() {
-        "atom_style" if w.get(1).map(|s| s.as_str()) == Some("granular") => Some(Action::Replace(vec!["atom_style sphere".into()])),
+        "atom_style" if w.get(1).map(|s| s.as_str()) == Some("granular") => Some(Action::Replace(vec![if ctx.facts.has_adapt { "atom_style sphere 1".into() } else { "atom_style sphere".into() }])),
+        "atom_modify" if ctx.facts.has_insertion && w.windows(2).any(|p| p[0] == "map" && p[1] == "array") => {
+            ctx.note(Severity::Info, "atom_modify map array -> map hash: LAMMPS 29Sep2021 fix pour segfaults in Atom::map_set with map array (observed)".into());
+            Some(Action::Replace(vec![w.iter().map(|x| if x == "array" { "hash" } else { x.as_str() }).collect::<Vec<_>>().join(" ")]))
+        }
         "communicate" => {
             if w.windows(2).any(|p| p[0] == "vel" && p[1] == "yes") {
                 Some(Action::Replace(vec!["comm_modify vel yes".into()]))
@@ -222,6 +228,11 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
         "pair_style" => lammps::pair_style_to_lammps(ctx, w),
         "pair_coeff" => lammps::pair_coeff_to_lammps(ctx, w),
         "compute_modify" if w.iter().any(|x| x == "dynamic") => Some(Action::Replace(vec![w.iter().map(|x| if x == "dynamic" { "dynamic/dof" } else { x.as_str() }).collect::<Vec<_>>().join(" ")])),
+        "dump" if w.get(3).map(|s| s.as_str()) == Some("custom") && w.iter().skip(6).any(|x| refs_dropped(ctx, x)) => {
+            let kept: Vec<String> = w.iter().enumerate().filter(|(i, x)| *i < 6 || !refs_dropped(ctx, x)).map(|(_, x)| x.clone()).collect();
+            ctx.note(Severity::Approx, "dump columns of dropped or implicit LIGGGHTS fixes removed".into());
+            Some(Action::Replace(vec![kept.join(" ")]))
+        }
         "dump" if w.len() >= 4 => match w[3].as_str() {
             "custom/vtk" => {
                 ctx.note(Severity::Approx, "dump custom/vtk written as a LAMMPS text dump custom (Debian LAMMPS has no VTK dumps)".into());
@@ -257,7 +268,9 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
                     }
                 }
                 "wall/gran" => lammps::wall_to_lammps(ctx, w),
+                "insert/pack" | "insert/rate/region" if ctx.facts.gravity.is_none() => Some(Action::Drop("LAMMPS fix pour (the only insertion fix) needs fix gravity".into(), Severity::Dropped)),
                 "insert/pack" | "insert/rate/region" => lammps::insert_to_pour(ctx, w),
+                "pour" | "pour/legacy" => lammps::pour_to_lammps(ctx, w),
                 s if s.starts_with("particletemplate/") || s.starts_with("particledistribution/") => Some(Action::Drop("template folded into fix pour".into(), Severity::Info)),
                 s if s.starts_with("mesh/surface") || s.starts_with("move/mesh") || s.starts_with("insert/") || s.starts_with("couple/") || s.starts_with("heat/") || s.starts_with("check/timestep") || s == "property/atom" || s.starts_with("massflow") || s.starts_with("multisphere") => {
                     Some(Action::Drop(format!("fix {s} has no LAMMPS counterpart"), Severity::Dropped))
