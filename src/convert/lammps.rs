@@ -1,0 +1,708 @@
+//! LIGGGHTS 3.x <-> LAMMPS (29 Sep 2021) granular commands.
+//!
+//! Hertz: LIGGGHTS `model hertz` with materials maps to LAMMPS `pair_style
+//! granular` `hertz/material E e' nu tangential mindlin kt xgt mu damping
+//! tsuji` where
+//! - `E = 2(1-nu^2) Y*` (LAMMPS takes E_eff = E/(2(1-nu^2)) for explicit
+//!   coefficients), `kt = 8 G*` (LAMMPS mindlin force kt a xi, LIGGGHTS
+//!   kt = 8 G* sqrt(R* delta));
+//! - LAMMPS tsuji damping is alpha(e') sqrt(m* (4/3) Y* a), LIGGGHTS's is
+//!   2 sqrt(5/6) |beta(e)| sqrt(2 Y* a m*): equal when alpha(e') =
+//!   sqrt(5) |beta(e)|, so e' is solved from that (possible for e >= ~0.114);
+//! - tangential damping ratio xgt = gamma_t/gamma_n = 2 sqrt(G*/Y*).
+//! The normal force law is then identical; what remains different is the
+//! tangential model (LAMMPS caps the total tangential force including
+//! damping and rescales history; LIGGGHTS caps the elastic part, no damping
+//! while sliding; lever arm R vs R - delta/2).
+
+use super::deck::{fmt, is_number, Facts};
+use super::legacy;
+use super::{Action, Ctx, Severity};
+
+/// LAMMPS 2021 tsuji polynomial alpha(e).
+pub fn tsuji_alpha(e: f64) -> f64 {
+    let c = [1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218];
+    c.iter().rev().fold(0.0, |acc, k| acc * e + k)
+}
+
+/// LIGGGHTS beta(e) = ln e / sqrt(ln^2 e + pi^2) (negative).
+pub fn beta(e: f64) -> f64 {
+    let l = e.ln();
+    l / (l * l + std::f64::consts::PI.powi(2)).sqrt()
+}
+
+/// Restitution e whose beta has magnitude `b` (inverse of [`beta`]).
+pub fn e_from_beta(b: f64) -> f64 {
+    let b = b.abs().min(0.999_999);
+    (-std::f64::consts::PI * b / (1.0 - b * b).sqrt()).exp()
+}
+
+/// The e' to give LAMMPS `damping tsuji` so it damps like LIGGGHTS hertz
+/// with restitution `e`; None when no e' in [0,1] reaches it.
+pub fn tsuji_e_for(e: f64) -> Option<f64> {
+    if e >= 1.0 {
+        return Some(1.0);
+    }
+    let target = 5f64.sqrt() * beta(e).abs();
+    if target > tsuji_alpha(0.0) {
+        return None;
+    }
+    // alpha decreases on [0, 1]: bisection
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if tsuji_alpha(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// LIGGGHTS restitution that LAMMPS tsuji with e' reproduces.
+pub fn liggghts_e_for_tsuji(e_prime: f64) -> f64 {
+    e_from_beta(tsuji_alpha(e_prime) / 5f64.sqrt())
+}
+
+/// Mixed material of a type pair (LIGGGHTS mixing, engines.md 1.3).
+struct Pair {
+    y_star: f64,
+    g_star: f64,
+    nu: f64,
+    e: f64,
+    mu: f64,
+}
+
+fn pair_material(f: &Facts, i: usize, j: usize) -> Option<Pair> {
+    let y = f.per_type("youngsModulus")?;
+    let nu = f.per_type("poissonsRatio")?;
+    let (yi, yj, ni, nj) = (*y.get(i - 1)?, *y.get(j - 1)?, *nu.get(i - 1)?, *nu.get(j - 1)?);
+    let y_star = 1.0 / ((1.0 - ni * ni) / yi + (1.0 - nj * nj) / yj);
+    let g_star = 1.0 / (2.0 * (2.0 - ni) * (1.0 + ni) / yi + 2.0 * (2.0 - nj) * (1.0 + nj) / yj);
+    let e = f.pair_value("coefficientRestitution", i, j)?;
+    let mu = f.pair_value("coefficientFriction", i, j)?;
+    Some(Pair { y_star, g_star, nu: 0.5 * (ni + nj), e, mu })
+}
+
+/// Parsed LIGGGHTS 3.x model block (fields private to the converter).
+#[derive(Default, Debug, Clone)]
+pub struct Model3 {
+    normal: String,
+    tangential: String,
+    cohesion: Option<String>,
+    rolling: Option<String>,
+    tangential_damping: bool,
+    rest: Vec<String>,
+}
+
+fn parse_model3(w: &[String]) -> Option<(Model3, Vec<String>)> {
+    let mut m = Model3 { tangential_damping: true, tangential: "history".into(), ..Default::default() };
+    let mut i = 0;
+    let mut other = Vec::new();
+    while i < w.len() {
+        let k = w[i].as_str();
+        let v = w.get(i + 1).cloned();
+        match (k, v) {
+            ("model", Some(v)) => m.normal = v,
+            ("tangential", Some(v)) => m.tangential = v,
+            ("cohesion", Some(v)) => m.cohesion = Some(v),
+            ("rolling_friction", Some(v)) => m.rolling = Some(v),
+            ("surface", Some(v)) if v == "default" => {}
+            ("tangential_damping", Some(v)) => m.tangential_damping = v != "off",
+            _ => {
+                other.push(w[i].clone());
+                i += 1;
+                continue;
+            }
+        }
+        i += 2;
+    }
+    if m.normal.is_empty() {
+        return None;
+    }
+    Some((m, other))
+}
+
+/// LAMMPS granular coefficient string for type pair (i, j) under model `m`.
+fn granular_coeffs(ctx: &mut Ctx, m: &Model3, i: usize, j: usize) -> Option<String> {
+    let f = ctx.facts;
+    match m.normal.as_str() {
+        "hertz" => {
+            let p = pair_material(f, i, j)?;
+            let e_p = match tsuji_e_for(p.e) {
+                Some(x) => x,
+                None => {
+                    ctx.note(Severity::Approx, format!("restitution {} is below what LAMMPS tsuji can reach (~0.114): e' = 0 used", p.e));
+                    0.0
+                }
+            };
+            let e_lmp = 2.0 * (1.0 - p.nu * p.nu) * p.y_star;
+            let xgt = if m.tangential_damping { 2.0 * (p.g_star / p.y_star).sqrt() } else { 0.0 };
+            let tang = match m.tangential.as_str() {
+                "history" => format!("mindlin {} {} {}", fmt(8.0 * p.g_star), fmt(xgt), fmt(p.mu)),
+                "no_history" => format!("linear_nohistory {} {}", fmt(xgt), fmt(p.mu)),
+                other => {
+                    ctx.note(Severity::Approx, format!("tangential {other} has no LAMMPS counterpart: mindlin used"));
+                    format!("mindlin {} {} {}", fmt(8.0 * p.g_star), fmt(xgt), fmt(p.mu))
+                }
+            };
+            Some(format!("hertz/material {} {} {} tangential {tang} damping tsuji", fmt(e_lmp), fmt(e_p), fmt(p.nu)))
+        }
+        "hooke/stiffness" | "hertz/stiffness" => {
+            let kn = f.pair_value("kn", i, j)?;
+            let kt = f.pair_value("kt", i, j)?;
+            let gn = f.pair_value("gamman", i, j)?;
+            let gt = f.pair_value("gammat", i, j)?;
+            let mu = f.pair_value("coefficientFriction", i, j)?;
+            let normal = if m.normal == "hooke/stiffness" { "hooke" } else { "hertz" };
+            let xgt = if gn != 0.0 { gt / gn } else { 0.0 };
+            let tang = if m.tangential == "no_history" { format!("linear_nohistory {} {}", fmt(xgt), fmt(mu)) } else { format!("linear_history {} {} {}", fmt(kt), fmt(xgt), fmt(mu)) };
+            Some(format!("{normal} {} {} tangential {tang} damping mass_velocity", fmt(kn), fmt(gn)))
+        }
+        _ => None,
+    }
+}
+
+fn ntypes(ctx: &Ctx) -> usize {
+    ctx.facts.ntypes.unwrap_or(1).max(1)
+}
+
+/// Classic `gran/hooke/history` form when the model and values allow it.
+fn classic_style(ctx: &Ctx, m: &Model3) -> Option<String> {
+    let f = ctx.facts;
+    let style = match (m.normal.as_str(), m.tangential.as_str()) {
+        ("hooke/stiffness", "history") => "gran/hooke/history",
+        ("hooke/stiffness", "no_history") => "gran/hooke",
+        ("hertz/stiffness", "history") => "gran/hertz/history",
+        _ => return None,
+    };
+    let n = ntypes(ctx);
+    let names = ["kn", "kt", "gamman", "gammat", "coefficientFriction"];
+    let first: Vec<f64> = names.iter().map(|k| f.pair_value(k, 1, 1)).collect::<Option<_>>()?;
+    for i in 1..=n {
+        for j in 1..=n {
+            let v: Vec<f64> = names.iter().map(|k| f.pair_value(k, i, j)).collect::<Option<_>>()?;
+            if v != first {
+                return None;
+            }
+        }
+    }
+    if f.props.contains_key("gamman_abs") || m.rest.iter().any(|r| r == "absolute_damping") {
+        return None;
+    }
+    Some(format!("{style} {} {} {} {} {} 1", fmt(first[0]), fmt(first[1]), fmt(first[2]), fmt(first[3]), fmt(first[4])))
+}
+
+fn drop_model_axes(ctx: &mut Ctx, m: &Model3) {
+    if let Some(c) = &m.cohesion {
+        ctx.note(Severity::Approx, format!("cohesion {c} has no LAMMPS counterpart (dmt/jkr are different laws): dropped"));
+    }
+    if let Some(r) = &m.rolling {
+        ctx.note(Severity::Approx, format!("rolling_friction {r} has no LAMMPS counterpart (rolling sds is a different law): dropped"));
+    }
+}
+
+/// 3.x `pair_style gran model ...` -> LAMMPS (the coefficients go to the
+/// `pair_coeff` line).
+pub fn pair_style_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if w.get(1).map(|s| s.as_str()) != Some("gran") {
+        return None;
+    }
+    let (m, other) = match parse_model3(&w[2..]) {
+        Some(x) => x,
+        None => return Some(Action::Drop("pair_style gran without model".into(), Severity::Dropped)),
+    };
+    if !other.is_empty() {
+        ctx.note(Severity::Approx, format!("model keywords '{}' dropped", other.join(" ")));
+    }
+    if !matches!(m.normal.as_str(), "hertz" | "hooke/stiffness" | "hertz/stiffness") {
+        ctx.pair_dropped = true;
+        return Some(Action::Drop(format!("model {} has no LAMMPS counterpart with the same law (LIGGGHTS hooke derives kn from characteristicVelocity and each pair's mass and radius)", m.normal), Severity::Dropped));
+    }
+    drop_model_axes(ctx, &m);
+    let line = if let Some(s) = classic_style(ctx, &m) {
+        ctx.pair_done = true;
+        format!("pair_style {s}")
+    } else {
+        "pair_style granular".to_string()
+    };
+    ctx.model = Some(m);
+    if ctx.model.as_ref().map(|m| m.normal == "hertz").unwrap_or(false) {
+        ctx.note(Severity::Approx, "hertz: normal force identical (tsuji e' solved to match LIGGGHTS damping); tangential differs: LAMMPS caps |elastic+damping| and rescales history, LIGGGHTS caps the elastic part and does not damp while sliding; lever arm R vs R-delta/2".into());
+    }
+    Some(Action::Replace(vec![line]))
+}
+
+/// `pair_coeff * *` after a converted 3.x pair_style.
+pub fn pair_coeff_to_lammps(ctx: &mut Ctx, _w: &[String]) -> Option<Action> {
+    if ctx.pair_dropped {
+        return Some(Action::Drop("belongs to the dropped pair_style".into(), Severity::Info));
+    }
+    let m = ctx.model.take()?;
+    if ctx.pair_done {
+        ctx.pair_done = false;
+        return Some(Action::Replace(vec!["pair_coeff * *".into()]));
+    }
+    let n = ntypes(ctx);
+    let mut lines = Vec::new();
+    for i in 1..=n {
+        for j in i..=n {
+            match granular_coeffs(ctx, &m, i, j) {
+                Some(c) => lines.push(format!("pair_coeff {i} {j} {c}")),
+                None => return Some(Action::Drop(format!("model {} or its material properties (constant numbers) not convertible", m.normal), Severity::Dropped)),
+            }
+        }
+    }
+    ctx.wall_model = Some(m);
+    Some(Action::Replace(lines))
+}
+
+/// Wall coefficient string for a wall of material type `t` (particle type 1).
+fn wall_coeffs(ctx: &mut Ctx, m: &Model3, t: usize) -> Option<String> {
+    if ntypes(ctx) > 1 {
+        ctx.note(Severity::Approx, "LAMMPS wall/gran takes one coefficient set for all particle types: type 1 against the wall type used".into());
+    }
+    let f = ctx.facts;
+    if m.normal.ends_with("/stiffness") {
+        let names = ["kn", "kt", "gamman", "gammat", "coefficientFriction"];
+        let v: Vec<f64> = names.iter().map(|k| f.pair_value(k, 1, t)).collect::<Option<_>>()?;
+        let style = match (m.normal.as_str(), m.tangential.as_str()) {
+            ("hooke/stiffness", "no_history") => "hooke",
+            ("hooke/stiffness", _) => "hooke/history",
+            _ => "hertz/history",
+        };
+        return Some(format!("{style} {} {} {} {} {} 1", fmt(v[0]), fmt(v[1]), fmt(v[2]), fmt(v[3]), fmt(v[4])));
+    }
+    Some(format!("granular {}", granular_coeffs(ctx, m, 1, t)?))
+}
+
+/// 3.x `fix ID G wall/gran model ... primitive type T geom args` -> LAMMPS.
+pub fn wall_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if w.get(3).map(|s| s.as_str()) != Some("wall/gran") || w.get(4).map(|s| s.as_str()) != Some("model") {
+        return None;
+    }
+    let (id, group) = (&w[1], &w[2]);
+    let pos = match w.iter().position(|x| x == "primitive") {
+        Some(p) => p,
+        None => return Some(Action::Drop("mesh walls: LAMMPS 2021 has no triangle-mesh granular walls".into(), Severity::Dropped)),
+    };
+    let (m, other) = parse_model3(&w[4..pos])?;
+    let tail = &w[pos + 1..];
+    // primitive type T geom args [keywords]
+    if tail.len() < 4 || tail[0] != "type" {
+        return Some(Action::Drop("primitive wall arguments not understood".into(), Severity::Dropped));
+    }
+    let t: usize = match ctx.facts.num(&tail[1]) {
+        Some(v) => v as usize,
+        None => return Some(Action::Drop("wall type is not a constant number".into(), Severity::Dropped)),
+    };
+    let geom = tail[2].as_str();
+    let mut rest_words = Vec::new();
+    let (m, _) = {
+        let mut m = m;
+        // keywords after the geometry (tangential_damping off etc.)
+        let nargs = match geom {
+            "xplane" | "yplane" | "zplane" => 1,
+            _ => 3,
+        };
+        let after = tail.get(3 + nargs..).unwrap_or(&[]);
+        let mut i = 0;
+        while i < after.len() {
+            if after[i] == "tangential_damping" {
+                m.tangential_damping = after.get(i + 1).map(|s| s.as_str()) != Some("off");
+                i += 2;
+            } else {
+                rest_words.push(after[i].clone());
+                i += 1;
+            }
+        }
+        (m, ())
+    };
+    if !other.is_empty() || !rest_words.is_empty() {
+        ctx.note(Severity::Approx, format!("wall words '{}' dropped", other.iter().chain(&rest_words).cloned().collect::<Vec<_>>().join(" ")));
+    }
+    drop_model_axes(ctx, &m);
+    let coeffs = match wall_coeffs(ctx, &m, t) {
+        Some(c) => c,
+        None if ctx.pair_dropped => return Some(Action::Drop("the pair model was dropped; its wall goes too".into(), Severity::Dropped)),
+        None => return Some(Action::Drop(format!("wall model {} or its material properties not convertible", m.normal), Severity::Dropped)),
+    };
+    let line = match geom {
+        "xplane" | "yplane" | "zplane" => {
+            let v = &tail[3];
+            let axis = (geom.as_bytes()[0] - b'x') as usize;
+            let val = ctx.facts.num(v);
+            let lower = match (val, ctx.facts.box_bounds(axis)) {
+                (Some(x), Some((lo, hi))) => (x - lo).abs() <= (x - hi).abs(),
+                _ => true,
+            };
+            if lower {
+                format!("fix {id} {group} wall/gran {coeffs} {geom} {v} NULL")
+            } else {
+                format!("fix {id} {group} wall/gran {coeffs} {geom} NULL {v}")
+            }
+        }
+        "zcylinder" if tail.len() >= 6 => {
+            let (r, c1, c2) = (&tail[3], &tail[4], &tail[5]);
+            if ctx.facts.num(c1) == Some(0.0) && ctx.facts.num(c2) == Some(0.0) {
+                format!("fix {id} {group} wall/gran {coeffs} zcylinder {r}")
+            } else {
+                let rid = format!("demx_{id}");
+                return Some(Action::Replace(vec![
+                    format!("region {rid} cylinder z {c1} {c2} {r} INF INF units box"),
+                    format!("fix {id} {group} wall/gran/region {coeffs} region {rid}"),
+                ]));
+            }
+        }
+        "xcylinder" | "ycylinder" if tail.len() >= 6 => {
+            let rid = format!("demx_{id}");
+            return Some(Action::Replace(vec![
+                format!("region {rid} cylinder {} {} {} {} INF INF units box", &geom[..1], tail[4], tail[5], tail[3]),
+                format!("fix {id} {group} wall/gran/region {coeffs} region {rid}"),
+            ]));
+        }
+        _ => return Some(Action::Drop(format!("primitive wall {geom} has no LAMMPS wall/gran form"), Severity::Dropped)),
+    };
+    Some(Action::Replace(vec![line]))
+}
+
+/// 3.x insertion (`insert/pack`, `insert/rate/region`) -> LAMMPS `fix pour`.
+pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    let style = w.get(3)?.as_str();
+    if style != "insert/pack" && style != "insert/rate/region" {
+        return None;
+    }
+    let (id, group) = (&w[1], &w[2]);
+    let f = ctx.facts;
+    let get = |k: &str| w.iter().position(|x| x == k).and_then(|i| w.get(i + 1)).cloned();
+    let (Some(pdd), Some(region)) = (get("distributiontemplate"), get("region")) else {
+        return Some(Action::Drop("insertion without distributiontemplate/region".into(), Severity::Dropped));
+    };
+    let Some(dist) = f.distributions.get(&pdd) else {
+        return Some(Action::Drop(format!("distribution {pdd} not found"), Severity::Dropped));
+    };
+    // templates: diameters, number fractions from mass weights
+    let mut sizes = Vec::new();
+    let mut dens = Vec::new();
+    let mut ty = None;
+    for (tid, wt) in dist {
+        let Some(t) = f.templates.get(tid) else {
+            return Some(Action::Drop(format!("template {tid} not found"), Severity::Dropped));
+        };
+        let (Some(r), Some(rho), Some(wt)) = (f.num(&t.radius), f.num(&t.density), f.num(wt)) else {
+            return Some(Action::Drop("template values are not constant numbers".into(), Severity::Dropped));
+        };
+        sizes.push((2.0 * r, wt / (r * r * r)));
+        dens.push(rho);
+        if ty.is_some() && ty.as_ref() != Some(&t.atom_type) {
+            ctx.note(Severity::Approx, "templates of several atom types: fix pour inserts one type (the first)".into());
+        }
+        ty.get_or_insert(t.atom_type.clone());
+    }
+    let qsum: f64 = sizes.iter().map(|s| s.1).sum();
+    let vp: f64 = sizes.iter().map(|(d, q)| q / qsum * std::f64::consts::PI / 6.0 * d * d * d).sum();
+    let n = if let Some(n) = get("particles_in_region").or(get("nparticles")) {
+        f.num(&n)
+    } else if let Some(fr) = get("volumefraction_region") {
+        f.num(&fr).and_then(|fr| f.region_volume(&region).map(|v| (fr * v / vp).floor()))
+    } else if let Some(m) = get("mass_in_region").or(get("mass")) {
+        let mp: f64 = sizes.iter().zip(&dens).map(|((d, q), rho)| q / qsum * rho * std::f64::consts::PI / 6.0 * d * d * d).sum();
+        f.num(&m).map(|m| (m / mp).floor())
+    } else {
+        None
+    };
+    let Some(n) = n else {
+        return Some(Action::Drop("number of particles to insert not known as a constant".into(), Severity::Dropped));
+    };
+    let diam = if sizes.len() == 1 {
+        format!("diam one {}", fmt(sizes[0].0))
+    } else {
+        let parts: Vec<String> = sizes.iter().map(|(d, q)| format!("{} {}", fmt(*d), fmt(q / qsum))).collect();
+        format!("diam poly {} {}", sizes.len(), parts.join(" "))
+    };
+    let (dlo, dhi) = dens.iter().fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(*x), b.max(*x)));
+    if dlo != dhi {
+        ctx.note(Severity::Approx, "templates of different densities: fix pour draws density uniformly in their range".into());
+    }
+    let vel = match w.iter().position(|x| x == "vel") {
+        Some(i) if w.get(i + 1).map(|s| s.as_str()) == Some("constant") => w.get(i + 2..i + 5).map(|v| format!("vel {} {} {} {} {}", v[0], v[0], v[1], v[1], v[2])),
+        _ => None,
+    }
+    .unwrap_or_default();
+    let frac = if let Some(fr) = get("volumefraction_region") { fr } else { "0.25".into() };
+    let seed = get("seed").unwrap_or_else(|| "12345".into());
+    ctx.note(Severity::Approx, format!("{style} mapped to fix pour ({n} particles): pour inserts batches at volume fraction {frac} as earlier ones fall out of region {region}; positions and timing differ; pour needs gravity and a block or z-cylinder region"));
+    Some(Action::Replace(vec![format!(
+        "fix {id} {group} pour {} {} {seed} region {region} {diam} dens {} {} vol {frac} 100 {vel}",
+        n,
+        ty.unwrap_or_else(|| "1".into()),
+        fmt(dlo),
+        fmt(dhi)
+    )
+    .trim_end()
+    .to_string()]))
+}
+
+/// Material values to LIGGGHTS property/global lines from LAMMPS pair
+/// coefficients of the classic styles.
+pub fn classic_to_liggghts(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    let style = w.get(1)?.as_str();
+    let (normal, tang) = match style {
+        "gran/hooke/history" => ("hooke/stiffness", "history"),
+        "gran/hooke" => ("hooke/stiffness", "no_history"),
+        "gran/hertz/history" => ("hertz/stiffness", "history"),
+        _ => return None,
+    };
+    let a = w.get(2..8)?;
+    if !is_number(&a[0]) {
+        return None;
+    }
+    let f = ctx.facts;
+    let kn = f.num(&a[0])?;
+    let kt = if a[1] == "NULL" { 2.0 / 7.0 * kn } else { f.num(&a[1])? };
+    let gn = f.num(&a[2])?;
+    let mut gt = if a[3] == "NULL" { 0.5 * gn } else { f.num(&a[3])? };
+    let mu = f.num(&a[4])?;
+    if f.num(&a[5]) == Some(0.0) {
+        gt = 0.0;
+    }
+    if w.len() > 8 {
+        ctx.note(Severity::Approx, format!("pair_style words '{}' dropped", w[8..].join(" ")));
+    }
+    ctx.note(Severity::Approx, "LIGGGHTS */stiffness: Coulomb cap on the elastic part only, no damping while sliding, lever arm R-delta/2 (LAMMPS: total force cap, lever arm R)".into());
+    let n = ntypes(ctx);
+    let pp = |name: &str, v: f64| format!("fix demx_{name} all property/global {name} peratomtypepair {n} {}", vec![fmt(v); n * n].join(" "));
+    let mut lines = Vec::new();
+    if !ctx.facts.has_newton_off {
+        lines.push("newton off".to_string());
+    }
+    lines.push(pp("kn", kn));
+    lines.push(pp("kt", kt));
+    lines.push(pp("gamman", gn));
+    lines.push(pp("gammat", gt));
+    lines.push(pp("coefficientFriction", mu));
+    lines.push(format!("pair_style gran model {normal} tangential {tang}"));
+    ctx.pair_done = true;
+    ctx.liggghts_walls = Some((normal.to_string(), tang.to_string()));
+    Some(Action::Replace(lines))
+}
+
+/// LAMMPS `pair_style granular` -> `pair_style gran model hertz` (values come
+/// from the `pair_coeff` lines, turned into property/global there).
+pub fn granular_to_liggghts(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if w.get(1).map(|s| s.as_str()) != Some("granular") {
+        return None;
+    }
+    ctx.granular = true;
+    Some(Action::Drop("pair_style granular: becomes pair_style gran with the pair_coeff values below".into(), Severity::Info))
+}
+
+/// Parsed `hertz/material E e nu tangential mindlin kt xgt mu damping tsuji`.
+struct HertzCoeff {
+    e_mod: f64,
+    e_rest: f64,
+    nu: f64,
+    tangential: String,
+    xgt: f64,
+    mu: f64,
+    damping: String,
+}
+
+fn parse_hertz(f: &Facts, a: &[String]) -> Option<HertzCoeff> {
+    if a.first()? != "hertz/material" {
+        return None;
+    }
+    let mut c = HertzCoeff {
+        e_mod: f.num(a.get(1)?)?,
+        e_rest: f.num(a.get(2)?)?,
+        nu: f.num(a.get(3)?)?,
+        tangential: String::new(),
+        xgt: 0.0,
+        mu: 0.0,
+        damping: "viscoelastic".into(),
+    };
+    let mut i = 4;
+    while i < a.len() {
+        match a[i].as_str() {
+            "tangential" => {
+                c.tangential = a.get(i + 1)?.clone();
+                if c.tangential == "linear_nohistory" {
+                    c.xgt = f.num(a.get(i + 2)?)?;
+                    c.mu = f.num(a.get(i + 3)?)?;
+                    i += 4;
+                } else {
+                    c.xgt = f.num(a.get(i + 3)?)?;
+                    c.mu = f.num(a.get(i + 4)?)?;
+                    i += 5;
+                }
+            }
+            "damping" => {
+                c.damping = a.get(i + 1)?.clone();
+                i += 2;
+            }
+            _ => return None,
+        }
+    }
+    Some(c)
+}
+
+/// `pair_coeff I J hertz/material ...` lines of `pair_style granular`:
+/// the type-diagonal ones become LIGGGHTS materials (all lines are read
+/// from the deck facts at the first pair_coeff).
+pub fn granular_coeff_to_liggghts(ctx: &mut Ctx, w: &[String], all: &[Vec<String>]) -> Option<Action> {
+    if !ctx.granular {
+        return None;
+    }
+    if ctx.pair_done {
+        return Some(Action::Drop("folded into the property/global lines above".into(), Severity::Info));
+    }
+    let f = ctx.facts;
+    let n = ntypes(ctx);
+    // collect coefficients per type pair
+    let mut per: Vec<Option<HertzCoeff>> = (0..n * n).map(|_| None).collect();
+    for c in all {
+        let (Some(i), Some(j)) = (c.get(1), c.get(2)) else { continue };
+        let range = |s: &str| -> Vec<usize> {
+            if s == "*" {
+                (1..=n).collect()
+            } else {
+                s.parse::<usize>().ok().filter(|x| *x >= 1 && *x <= n).into_iter().collect()
+            }
+        };
+        let Some(h) = parse_hertz(f, &c[3..]) else {
+            return Some(Action::Drop("pair_coeff of pair_style granular: only hertz/material converts to LIGGGHTS".into(), Severity::Dropped));
+        };
+        for a in range(i) {
+            for b in range(j) {
+                per[(a - 1) * n + (b - 1)] = parse_hertz(f, &c[3..]);
+                per[(b - 1) * n + (a - 1)] = parse_hertz(f, &c[3..]);
+            }
+        }
+        let _ = h;
+    }
+    let mut ym = Vec::new();
+    let mut nu = Vec::new();
+    let mut rest = Vec::new();
+    let mut fric = Vec::new();
+    let mut tdamp = None;
+    let mut tang = "history";
+    for i in 0..n {
+        let Some(c) = per[i * n + i].as_ref() else {
+            return Some(Action::Drop(format!("no pair_coeff for type {}", i + 1), Severity::Dropped));
+        };
+        ym.push(fmt(c.e_mod));
+        nu.push(fmt(c.nu));
+    }
+    for c in per.iter() {
+        let Some(c) = c else {
+            return Some(Action::Drop("pair_coeff does not cover every type pair".into(), Severity::Dropped));
+        };
+        let e = match c.damping.as_str() {
+            "tsuji" => liggghts_e_for_tsuji(c.e_rest),
+            d => {
+                ctx.note(Severity::Approx, format!("damping {d}: no LIGGGHTS counterpart, restitution {} taken as a constant coefficient", c.e_rest));
+                c.e_rest
+            }
+        };
+        rest.push(fmt(e));
+        fric.push(fmt(c.mu));
+        if c.tangential == "linear_nohistory" {
+            tang = "no_history";
+        }
+        tdamp.get_or_insert(c.xgt != 0.0);
+    }
+    ctx.note(Severity::Approx, "hertz/material + tsuji -> LIGGGHTS hertz: restitution from alpha(e') = sqrt(5)|beta(e)| (same normal force); tangential cap, history and lever arm conventions differ".into());
+    let mut lines = Vec::new();
+    if !f.has_newton_off {
+        lines.push("newton off".to_string());
+    }
+    lines.push(format!("fix demx_m1 all property/global youngsModulus peratomtype {}", ym.join(" ")));
+    lines.push(format!("fix demx_m2 all property/global poissonsRatio peratomtype {}", nu.join(" ")));
+    lines.push(format!("fix demx_m3 all property/global coefficientRestitution peratomtypepair {n} {}", rest.join(" ")));
+    lines.push(format!("fix demx_m4 all property/global coefficientFriction peratomtypepair {n} {}", fric.join(" ")));
+    let td = if tdamp == Some(false) { " tangential_damping off" } else { "" };
+    lines.push(format!("pair_style gran model hertz tangential {tang}{td}"));
+    lines.push("pair_coeff * *".into());
+    ctx.pair_done = true;
+    ctx.liggghts_walls = Some(("hertz".into(), tang.into()));
+    let _ = w;
+    Some(Action::Replace(lines))
+}
+
+/// LAMMPS `fix ID G wall/gran STYLE ... {x,y,z}plane lo hi | zcylinder r` -> LIGGGHTS primitive walls.
+pub fn wall_to_liggghts(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if w.get(3).map(|s| s.as_str()) != Some("wall/gran") || w.get(4).map(|s| s.as_str()) == Some("model") {
+        return None;
+    }
+    let (id, group) = (&w[1], &w[2]);
+    let gpos = w.iter().position(|x| matches!(x.as_str(), "xplane" | "yplane" | "zplane" | "zcylinder"));
+    let Some(gpos) = gpos else {
+        return Some(Action::Drop("wall/gran geometry not understood".into(), Severity::Dropped));
+    };
+    let Some((normal, tang)) = ctx.liggghts_walls.clone() else {
+        return Some(Action::Drop("wall/gran before a convertible pair style".into(), Severity::Dropped));
+    };
+    ctx.note(Severity::Info, format!("wall {id} uses the pair materials of type 1 (LIGGGHTS primitive type 1); wall values written in the LAMMPS line are not re-read"));
+    let block = format!("model {normal} tangential {tang}");
+    let geom = w[gpos].as_str();
+    let extra = w.get(gpos + if geom == "zcylinder" { 2 } else { 3 }..).unwrap_or(&[]);
+    if !extra.is_empty() {
+        ctx.note(Severity::Approx, format!("wall words '{}' dropped", extra.join(" ")));
+    }
+    if geom == "zcylinder" {
+        return Some(Action::Replace(vec![format!("fix {id} {group} wall/gran {block} primitive type 1 zcylinder {} 0. 0.", w.get(gpos + 1)?)]));
+    }
+    let planes: Vec<&String> = w.get(gpos + 1..gpos + 3)?.iter().filter(|v| v.as_str() != "NULL").collect();
+    let ids: Vec<String> = if planes.len() == 1 { vec![id.clone()] } else { vec![format!("{id}1"), format!("{id}2")] };
+    if ids.len() > 1 {
+        ctx.split_ids.insert(id.clone(), ids.clone());
+    }
+    Some(Action::Replace(planes.iter().zip(&ids).map(|(p, i)| format!("fix {i} {group} wall/gran {block} primitive type 1 {geom} {p}")).collect()))
+}
+
+/// LAMMPS `fix pour` -> LIGGGHTS templates + insert/rate/region.
+pub fn pour_to_liggghts(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if !matches!(w.get(3)?.as_str(), "pour" | "pour/legacy") {
+        return None;
+    }
+    legacy::pour_to_insert(ctx, w)
+}
+
+/// Old `fix pour` syntax (`diam [uniform] lo hi`, `dens uniform`, `vel
+/// uniform`; LIGGGHTS 1.x and LAMMPS before 2013) -> LAMMPS 2021 syntax.
+pub fn pour_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if !matches!(w.get(3)?.as_str(), "pour" | "pour/legacy") {
+        return None;
+    }
+    let Some(p) = legacy::parse_pour(w) else {
+        return Some(Action::Drop("fix pour arguments not understood".into(), Severity::Dropped));
+    };
+    if ctx.facts.gravity.is_none() {
+        return Some(Action::Drop("LAMMPS fix pour needs fix gravity".into(), Severity::Dropped));
+    }
+    let mut s = format!("fix {} {} pour {} {} {} region {}", w[1], w[2], p.n, p.ty, p.seed, p.region);
+    if let Some((lo, hi)) = &p.diam_range {
+        if lo == hi {
+            s += &format!(" diam one {lo}");
+        } else {
+            s += &format!(" diam range {lo} {hi}");
+        }
+    } else if !p.poly.is_empty() {
+        let parts: Vec<String> = p.poly.iter().map(|(d, q)| format!("{d} {q}")).collect();
+        s += &format!(" diam poly {} {}", p.poly.len(), parts.join(" "));
+    }
+    if let Some((lo, hi)) = &p.dens {
+        s += &format!(" dens {lo} {hi}");
+    }
+    if let Some((f, n)) = &p.vol {
+        s += &format!(" vol {f} {n}");
+    }
+    if p.vel.len() == 5 {
+        s += &format!(" vel {}", p.vel.join(" "));
+    }
+    if !p.other.is_empty() {
+        ctx.note(Severity::Approx, format!("pour words '{}' dropped", p.other.join(" ")));
+    }
+    Some(Action::Replace(vec![s]))
+}
