@@ -673,6 +673,7 @@ pub fn extended_fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style:
     match style.text.as_str() {
         "wall/gran" if !a.rest().iter().any(|w| w.text == "mesh") => super::walls::wall_gran(s, cmd, id, group, style, a),
         "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" => super::mesh::fix(s, cmd, id, group, style, a, vars),
+        "aeolian/wind" => super::wind::fix(s, cmd, id, group, style, a, vars),
         _ => super::insert::fix(s, cmd, id, group, style, a, vars),
     }
 }
