@@ -770,7 +770,7 @@ pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: 
             Ok(())
         }
         "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" | "insert/pack" | "insert/stream"
-        | "insert/rate/region" | "particletemplate/sphere" | "particledistribution/discrete" | "pour" | "ave/time" => {
+        | "insert/rate/region" | "particletemplate/sphere" | "particledistribution/discrete" | "pour" | "ave/time" | "aeolian/wind" => {
             super::setup::extended_fix(s, cmd, id, group, style, a, vars)
         }
         other => {
