@@ -321,6 +321,7 @@ pub struct WindFix {
     zb: f64,
     tau_zb: f64,
     total_x: f64,
+    flux: f64,
     area: f64,
     /// Per base bin: tau_g at the bin bottom, phi, count (last update).
     tau_bins: Vec<f64>,
@@ -347,6 +348,7 @@ impl WindFix {
             zb: 0.0,
             tau_zb: 0.0,
             total_x: 0.0,
+            flux: 0.0,
             area: 1.0,
             tau_bins: vec![],
             phi: vec![],
@@ -471,7 +473,7 @@ impl Fix for WindFix {
         let mut t_bins = if file_due { vec![0.0; nb] } else { vec![] };
         let mut cnt = if file_due { vec![0u64; nb] } else { vec![] };
         let (dir, group) = (self.cfg.dir, self.cfg.group);
-        let (mut total, mut above) = (0.0, 0.0);
+        let (mut total, mut above, mut flux) = (0.0, 0.0, 0.0);
         let pure_log = !self.cfg.feedback;
         let zb = self.zb;
         let p = &mut sim.particles;
@@ -480,6 +482,7 @@ impl Fix for WindFix {
                 continue;
             }
             let z = p.x[i].z;
+            flux += p.mass[i] * p.v[i][dir];
             if z <= zb && !self.cfg.beddrag {
                 continue;
             }
@@ -508,6 +511,7 @@ impl Fix for WindFix {
             }
         }
         self.total_x = total / self.area;
+        self.flux = flux / self.area;
         if due {
             self.tau_zb = above / self.area;
         }
@@ -566,6 +570,7 @@ impl Fix for WindFix {
             2 => Some(if tau > 0.0 { self.tau_zb / tau } else { 0.0 }),
             3 => Some(self.wind_at(self.zb + 10.0 * self.dmean)),
             4 => Some(self.total_x),
+            5 => Some(self.flux),
             _ => None,
         }
     }
