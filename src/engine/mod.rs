@@ -12,5 +12,6 @@ pub mod sim;
 pub mod rng;
 pub mod insert;
 pub mod mesh_surface;
+pub mod wind;
 
 pub use sim::{Dialect, Sim};

@@ -14,6 +14,7 @@ pub mod walls;
 pub mod restart;
 pub mod insert;
 pub mod mesh;
+pub mod wind;
 
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{did_you_mean, Error, Result};

@@ -769,24 +769,6 @@ pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: 
             s.notes.push((cmd.span, format!("fix {}: accepted; demx reports timestep criteria in `demx check`", style.text)));
             Ok(())
         }
-        "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" | "insert/pack" | "insert/stream"
-        | "insert/rate/region" | "particletemplate/sphere" | "particledistribution/discrete" | "pour" => {
-            super::setup::extended_fix(s, cmd, id, group, style, a, vars)
-        }
-        other => {
-            let lig = [
-                "mesh/surface/stress", "mesh/surface/stress/servo", "couple/cfd", "couple/cfd/force", "heat/gran", "multisphere",
-                "particletemplate/multisphere", "massflow/mesh", "ave/euler", "property/atom/tracer", "wall/region/sph",
-                "insert/pack/dense", "nve/sphere/omp", "ave/chunk", "ave/atom", "deform", "rigid", "spring", "langevin", "nvt", "npt",
-                "wall/reflect", "wall/region", "store/state", "ave/histo", "heat/flow", "temp/rescale", "balance", "dt/reset",
-                "adapt", "python/invoke", "wiggle/mesh", "mesh/gran", "recenter", "setforce/region", "lineforce", "planeforce",
-                "efield", "wall/lj93",
-            ];
-            if lig.contains(&other) || other.contains('/') {
-                Err(Error::unsupported(style.span, format!("fix {other}")))
-            } else {
-                Err(bad_keyword(style, "fix style", &["nve/sphere", "gravity", "freeze", "addforce", "viscous", "wall/gran", "property/global", "insert/pack", "pour", "print"]))
-            }
-        }
+        _ => super::setup::extended_fix(s, cmd, id, group, style, a, vars),
     }
 }

@@ -667,12 +667,44 @@ fn delete_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     Ok(())
 }
 
-/// Fixes that need geometry or insertion machinery.
+/// Fix styles of LIGGGHTS 3.8 and LAMMPS that demx knows by name but does not
+/// run yet: they get exit 3 naming them, unknown words a did-you-mean error.
+const ENGINE_FIX_STYLES: &[&str] = &[
+    "mesh/surface/stress", "mesh/surface/stress/servo", "couple/cfd", "couple/cfd/force", "couple/cfd/force/implicit",
+    "heat/gran", "heat/gran/conduction", "multisphere", "particletemplate/multisphere", "particletemplate/superquadric",
+    "massflow/mesh", "ave/euler", "property/atom/tracer", "property/atom/tracer/stream", "wall/region/sph", "insert/pack/dense",
+    "nve/sphere/omp", "ave/chunk", "ave/atom", "ave/histo", "ave/correlate", "deform", "rigid", "rigid/small", "spring", "langevin",
+    "nvt", "npt", "nph", "wall/reflect", "wall/region", "store/state", "heat/flow", "temp/rescale", "balance", "dt/reset", "adapt",
+    "python/invoke", "wiggle/mesh", "mesh/gran", "recenter", "setforce/region", "lineforce", "planeforce", "efield", "wall/lj93",
+    "nve/limit", "nve/asphere", "bond/create", "bond/break", "wall/gran/hertz/history", "wall/gran/hooke/history", "wall/gran/hooke",
+    "pour/legacy", "pour/dev", "move/mesh/gran", "heat/radiation", "nve/superquadric", "particledistribution/discrete/numberbased",
+    "particledistribution/discrete/massbased", "insert/stream/predefined", "contactproperty/atom", "contacthistory", "sph",
+    "diam/max", "box/relax", "momentum", "viscous/sphere", "damping/cundall", "wall/gran/old",
+];
+
+/// Styles demx runs through the modules below.
+const DEMX_FIX_STYLES: &[&str] = &[
+    "wall/gran", "wall/gran/region", "mesh/surface", "mesh/surface/planar", "move/mesh", "insert/pack", "insert/stream",
+    "insert/rate/region", "particletemplate/sphere", "particledistribution/discrete", "pour", "aeolian/wind", "nve/sphere",
+    "nve", "gravity", "freeze", "addforce", "setforce", "viscous", "print", "ave/time", "property/global", "property/atom",
+];
+
+/// Fixes that need geometry, insertion or wind machinery; everything else
+/// gets a clear answer.
 pub fn extended_fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
-    
     match style.text.as_str() {
         "wall/gran" if !a.rest().iter().any(|w| w.text == "mesh") => super::walls::wall_gran(s, cmd, id, group, style, a),
         "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" => super::mesh::fix(s, cmd, id, group, style, a, vars),
-        _ => super::insert::fix(s, cmd, id, group, style, a, vars),
+        "aeolian/wind" => super::wind::fix(s, cmd, id, group, style, a, vars),
+        t if ENGINE_FIX_STYLES.contains(&t) || DEMX_FIX_STYLES.contains(&t) || t.starts_with("insert/") || t.starts_with("particle") || t == "adapt" => {
+            super::insert::fix(s, cmd, id, group, style, a, vars)
+        }
+        t => {
+            let mut e = Error::deck(style.span, format!("unknown fix style '{t}'"));
+            if let Some(h) = crate::error::did_you_mean(t, DEMX_FIX_STYLES.iter().chain(ENGINE_FIX_STYLES).copied()) {
+                e = e.with_hint(format!("did you mean '{h}'?"));
+            }
+            Err(e)
+        }
     }
 }
