@@ -94,7 +94,129 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
             s.sources.push(p.describe());
             s.add_fix(Box::new(p))
         }
+        "adapt" => {
+            let f = parse_adapt(s, id, group, a)?;
+            s.add_fix(Box::new(f))
+        }
         _ => Err(Error::unsupported(style.span, format!("fix {}", style.text))),
+    }
+}
+
+// ---------------------------------------------------------------- adapt
+
+/// `fix ID group adapt N atom diameter v_name [scale yes|no] [reset no]`:
+/// particle growth (LIGGGHTS/LAMMPS `fix adapt`, the atom-diameter form).
+/// The variable (equal- or atom-style) gives each particle's new diameter
+/// (times its current diameter with `scale yes`); the mass follows at
+/// constant density. Applied at the start of every run and every N steps.
+/// The engines apply it in `pre_force` of steps that are multiples of N;
+/// demx applies it at the end of the step before (same radii for that
+/// step's forces; the half-step velocity update before the force pass uses
+/// the new mass) and at run start after the setup forces.
+pub struct Adapt {
+    id: String,
+    group: u32,
+    nevery: i64,
+    var: String,
+    scale: bool,
+}
+
+fn parse_adapt(s: &Session, id: &str, group: u32, a: &mut Args) -> Result<Adapt> {
+    let nevery = a.i64("N")?;
+    if nevery < 0 {
+        return Err(a.err_prev("Illegal fix adapt command"));
+    }
+    let mut var = None;
+    let mut scale = false;
+    let mut reset = s.sim.dialect == Dialect::Lammps;
+    let mut reset_span = a.end_span();
+    while a.more() {
+        let k = a.word("attribute")?;
+        match k.text.as_str() {
+            "atom" => {
+                let what = a.word("atom attribute")?;
+                if what.text != "diameter" {
+                    return Err(Error::unsupported(what.span, format!("fix adapt atom {} (only diameter)", what.text)));
+                }
+                let v = a.word("v_name")?;
+                let Some(name) = v.text.strip_prefix("v_") else {
+                    return Err(Error::deck(v.span, "Illegal fix adapt command").with_hint("expected v_name"));
+                };
+                if var.is_some() {
+                    return Err(Error::unsupported(v.span, "fix adapt with several attributes"));
+                }
+                var = Some(name.to_string());
+            }
+            "pair" | "kspace" | "bond" => return Err(Error::unsupported(k.span, format!("fix adapt {}", k.text))),
+            "scale" => scale = a.yes_no("scale")?,
+            "reset" => {
+                reset = a.yes_no("reset")?;
+                reset_span = k.span;
+            }
+            "mass" => {
+                if !a.yes_no("mass")? {
+                    return Err(Error::unsupported(k.span, "fix adapt mass no"));
+                }
+            }
+            _ => return Err(bad_keyword(k, "fix adapt keyword", &["atom", "scale", "reset", "mass"])),
+        }
+    }
+    if reset {
+        return Err(Error::unsupported(reset_span, "fix adapt reset yes (restoring diameters after the run); add 'reset no'"));
+    }
+    let var = var.ok_or_else(|| Error::deck(a.end_span(), "fix adapt: no attribute to adapt"))?;
+    Ok(Adapt { id: id.to_string(), group, nevery, var, scale })
+}
+
+impl Adapt {
+    fn change(&self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        let vals = vars.eval_atom(&self.var, &*sim).map_err(|e| Error::runtime(format!("fix adapt {}: {e}", self.id)))?;
+        let p = &mut sim.particles;
+        if vals.len() != p.len() {
+            return Err(Error::runtime(format!("fix adapt {}: variable {} gave {} values for {} particles", self.id, self.var, vals.len(), p.len())));
+        }
+        for i in 0..p.len() {
+            if p.mask[i] & self.group == 0 {
+                continue;
+            }
+            let mut d = vals[i];
+            if self.scale {
+                d *= 2.0 * p.radius[i];
+            }
+            if !(d.is_finite() && d > 0.0) {
+                return Err(Error::runtime(format!("fix adapt {}: particle {} would get diameter {d}", self.id, p.tag[i])));
+            }
+            let r0 = p.radius[i];
+            let density = p.mass[i] / (4.0 * PI / 3.0 * r0 * r0 * r0);
+            p.radius[i] = 0.5 * d;
+            p.mass[i] = 4.0 * PI / 3.0 * p.radius[i].powi(3) * density;
+        }
+        sim.force_rebuild = true;
+        Ok(())
+    }
+}
+
+impl Fix for Adapt {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "adapt"
+    }
+    fn setup_output(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        if sim.dry {
+            return Ok(());
+        }
+        self.change(sim, vars)
+    }
+    fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        if self.nevery > 0 && (sim.step + 1) % self.nevery == 0 && sim.step < sim.run_end {
+            self.change(sim, vars)?;
+        }
+        Ok(())
+    }
+    fn summary(&self) -> String {
+        format!("fix adapt {}: diameter from v_{} every {} steps{}", self.id, self.var, self.nevery, if self.scale { " (scaled)" } else { "" })
     }
 }
 
