@@ -20,11 +20,13 @@ pub struct Logger {
     pub tty: bool,
     /// Everything printed, kept when `capture` is on (tests, check).
     pub captured: Option<String>,
+    /// When the progress line was last drawn.
+    last_progress: Option<std::time::Instant>,
 }
 
 impl Default for Logger {
     fn default() -> Self {
-        Logger { screen: true, file: None, progress_shown: false, tty: std::io::stderr().is_terminal(), captured: None }
+        Logger { screen: true, file: None, progress_shown: false, tty: std::io::stderr().is_terminal(), captured: None, last_progress: None }
     }
 }
 
@@ -66,6 +68,43 @@ impl Logger {
         self.file = Some(f);
         Ok(())
     }
+}
+
+/// Redraw the progress line (step, particles, elapsed, steps/s, ETA) of a
+/// run of `n` steps started at `t0`, at most 4 times a second, on a terminal
+/// only; cleared at the run's last step.
+pub fn show_progress(sim: &mut Sim, t0: std::time::Instant, n: i64) {
+    if !(sim.log.tty && sim.log.screen) {
+        return;
+    }
+    let now = std::time::Instant::now();
+    if sim.step >= sim.run_end {
+        sim.log.clear_progress();
+        sim.log.last_progress = None;
+        return;
+    }
+    if sim.log.last_progress.is_some_and(|t| now.duration_since(t).as_secs_f64() < 0.25) {
+        return;
+    }
+    sim.log.last_progress = Some(now);
+    let done = sim.step - sim.run_start;
+    let secs = now.duration_since(t0).as_secs_f64();
+    let rate = if secs > 0.0 { done as f64 / secs } else { 0.0 };
+    let eta = if rate > 0.0 { (n - done) as f64 / rate } else { f64::NAN };
+    let text = progress_text(sim.step, sim.run_end, sim.particles.len(), secs, rate, eta);
+    sim.log.progress(&text);
+}
+
+/// The progress line's text.
+pub fn progress_text(step: i64, end: i64, particles: usize, elapsed: f64, rate: f64, eta: f64) -> String {
+    let hms = |t: f64| {
+        if !t.is_finite() {
+            return "--:--:--".to_string();
+        }
+        let s = t.round() as i64;
+        format!("{:02}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60)
+    };
+    format!("step {step}/{end}  {particles} particles  elapsed {}  {rate:.1} steps/s  ETA {}", hms(elapsed), hms(eta))
 }
 
 /// What to do with particles lost through fixed boundaries.

@@ -261,6 +261,7 @@ impl Sim {
         let t0 = Instant::now();
         for _ in 0..n {
             self.one_step(vars)?;
+            super::output::show_progress(self, t0, n);
         }
         let secs = t0.elapsed().as_secs_f64();
         self.last_rate = if secs > 0.0 { n as f64 / secs } else { 0.0 };

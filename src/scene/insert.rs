@@ -1,7 +1,7 @@
 //! Particle insertion: LIGGGHTS 3.8 `particletemplate/sphere`,
 //! `particledistribution/discrete` (+ `/numberbased`, `/massbased`),
-//! `insert/pack`, `insert/rate/region` (`insert/stream` is unsupported: it
-//! needs an insertion-face mesh), and LAMMPS `fix pour`.
+//! `insert/pack`, `insert/rate/region`, `insert/stream` (through a planar
+//! `fix mesh/surface` face), and LAMMPS `fix pour`.
 //!
 //! Counts and schedules follow the engines (facts checked against the
 //! LIGGGHTS-PUBLIC 3.8 sources and the installed `liggghts`/`lmp`):
@@ -22,6 +22,17 @@
 //!   defined (or `start`), then every `insert_every` steps.
 //! - insert/rate/region: count per insertion int(rate dt every + u), capped
 //!   at the total (nparticles, or int(mass / M_expect)).
+//! - insert/stream: the face normal is flipped to point along `vel`;
+//!   insert_every = int((extrude_length + 1e-14) / (dt |v_n|)) unless given
+//!   (then extrude_length = duration dt |v_n|); per insertion int(rate dt
+//!   every + u). Before each insertion on a box with shrink-wrapped sides
+//!   (and before the first one anyway) LIGGGHTS estimates its share of the
+//!   extruded volume with `ntry_mc` points (mesh stream + fix stream), which
+//!   demx replays. A candidate is a random face point (triangle by area
+//!   from the mesh stream, seed 179424799, barycentric u, v redrawn while
+//!   u + v > 1) moved upstream by u extrude + r (fix stream); it must be in
+//!   the box at least r from its faces. Inserted particles move with v_n
+//!   (forces zeroed) until they cross the face, then get `vel` and `omega`.
 //! - fix pour: nper = int(volfrac V / V_one) (V_one from the largest
 //!   diameter, or the fraction-weighted mean for poly; in 3d dy < 1 is taken
 //!   as 1), insertions every nfreq = int(t / dt + 0.5) steps with t the fall
@@ -37,6 +48,7 @@ use super::args::{bad_keyword, parse_f64, parse_i64, Args};
 use super::Session;
 use crate::engine::domain::Domain;
 use crate::engine::fix::Fix;
+use crate::engine::mesh_surface::SharedMesh;
 use crate::engine::insert::{in_box, is_prime, random_point, region_volume_mc, OverlapGrid};
 use crate::engine::particles::{NewParticle, Particles};
 use crate::engine::rng::Park;
@@ -68,16 +80,13 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
             let d = parse_distribution(s, id, group, style, a)?;
             s.add_fix(Box::new(d))
         }
-        "insert/pack" | "insert/rate/region" => {
+        "insert/pack" | "insert/rate/region" | "insert/stream" => {
             s.set_dialect(Dialect::Liggghts);
             let f = parse_liggghts_insert(s, cmd, id, group, style, a)?;
             s.sources.push(f.describe());
             s.add_fix(Box::new(f))
         }
-        "insert/stream" | "insert/stream/predefined" => Err(Error::unsupported(
-            style.span,
-            format!("fix {} (insertion through a mesh face; use insert/rate/region with a thin region instead)", style.text),
-        )),
+        "insert/stream/predefined" => Err(Error::unsupported(style.span, format!("fix {}", style.text))),
         "pour" => {
             s.set_dialect(Dialect::Lammps);
             let p = parse_pour(s, cmd, id, group, a, vars)?;
@@ -85,7 +94,129 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
             s.sources.push(p.describe());
             s.add_fix(Box::new(p))
         }
+        "adapt" => {
+            let f = parse_adapt(s, id, group, a)?;
+            s.add_fix(Box::new(f))
+        }
         _ => Err(Error::unsupported(style.span, format!("fix {}", style.text))),
+    }
+}
+
+// ---------------------------------------------------------------- adapt
+
+/// `fix ID group adapt N atom diameter v_name [scale yes|no] [reset no]`:
+/// particle growth (LIGGGHTS/LAMMPS `fix adapt`, the atom-diameter form).
+/// The variable (equal- or atom-style) gives each particle's new diameter
+/// (times its current diameter with `scale yes`); the mass follows at
+/// constant density. Applied at the start of every run and every N steps.
+/// The engines apply it in `pre_force` of steps that are multiples of N;
+/// demx applies it at the end of the step before (same radii for that
+/// step's forces; the half-step velocity update before the force pass uses
+/// the new mass) and at run start after the setup forces.
+pub struct Adapt {
+    id: String,
+    group: u32,
+    nevery: i64,
+    var: String,
+    scale: bool,
+}
+
+fn parse_adapt(s: &Session, id: &str, group: u32, a: &mut Args) -> Result<Adapt> {
+    let nevery = a.i64("N")?;
+    if nevery < 0 {
+        return Err(a.err_prev("Illegal fix adapt command"));
+    }
+    let mut var = None;
+    let mut scale = false;
+    let mut reset = s.sim.dialect == Dialect::Lammps;
+    let mut reset_span = a.end_span();
+    while a.more() {
+        let k = a.word("attribute")?;
+        match k.text.as_str() {
+            "atom" => {
+                let what = a.word("atom attribute")?;
+                if what.text != "diameter" {
+                    return Err(Error::unsupported(what.span, format!("fix adapt atom {} (only diameter)", what.text)));
+                }
+                let v = a.word("v_name")?;
+                let Some(name) = v.text.strip_prefix("v_") else {
+                    return Err(Error::deck(v.span, "Illegal fix adapt command").with_hint("expected v_name"));
+                };
+                if var.is_some() {
+                    return Err(Error::unsupported(v.span, "fix adapt with several attributes"));
+                }
+                var = Some(name.to_string());
+            }
+            "pair" | "kspace" | "bond" => return Err(Error::unsupported(k.span, format!("fix adapt {}", k.text))),
+            "scale" => scale = a.yes_no("scale")?,
+            "reset" => {
+                reset = a.yes_no("reset")?;
+                reset_span = k.span;
+            }
+            "mass" => {
+                if !a.yes_no("mass")? {
+                    return Err(Error::unsupported(k.span, "fix adapt mass no"));
+                }
+            }
+            _ => return Err(bad_keyword(k, "fix adapt keyword", &["atom", "scale", "reset", "mass"])),
+        }
+    }
+    if reset {
+        return Err(Error::unsupported(reset_span, "fix adapt reset yes (restoring diameters after the run); add 'reset no'"));
+    }
+    let var = var.ok_or_else(|| Error::deck(a.end_span(), "fix adapt: no attribute to adapt"))?;
+    Ok(Adapt { id: id.to_string(), group, nevery, var, scale })
+}
+
+impl Adapt {
+    fn change(&self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        let vals = vars.eval_atom(&self.var, &*sim).map_err(|e| Error::runtime(format!("fix adapt {}: {e}", self.id)))?;
+        let p = &mut sim.particles;
+        if vals.len() != p.len() {
+            return Err(Error::runtime(format!("fix adapt {}: variable {} gave {} values for {} particles", self.id, self.var, vals.len(), p.len())));
+        }
+        for i in 0..p.len() {
+            if p.mask[i] & self.group == 0 {
+                continue;
+            }
+            let mut d = vals[i];
+            if self.scale {
+                d *= 2.0 * p.radius[i];
+            }
+            if !(d.is_finite() && d > 0.0) {
+                return Err(Error::runtime(format!("fix adapt {}: particle {} would get diameter {d}", self.id, p.tag[i])));
+            }
+            let r0 = p.radius[i];
+            let density = p.mass[i] / (4.0 * PI / 3.0 * r0 * r0 * r0);
+            p.radius[i] = 0.5 * d;
+            p.mass[i] = 4.0 * PI / 3.0 * p.radius[i].powi(3) * density;
+        }
+        sim.force_rebuild = true;
+        Ok(())
+    }
+}
+
+impl Fix for Adapt {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "adapt"
+    }
+    fn setup_output(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        if sim.dry {
+            return Ok(());
+        }
+        self.change(sim, vars)
+    }
+    fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
+        if self.nevery > 0 && (sim.step + 1) % self.nevery == 0 && sim.step < sim.run_end {
+            self.change(sim, vars)?;
+        }
+        Ok(())
+    }
+    fn summary(&self) -> String {
+        format!("fix adapt {}: diameter from v_{} every {} steps{}", self.id, self.var, self.nevery, if self.scale { " (scaled)" } else { "" })
     }
 }
 
@@ -476,12 +607,84 @@ pub struct LiggghtsInsert {
     pub ninserted: i64,
     /// Mass inserted so far.
     pub mass_inserted: f64,
+    /// insert/stream: the insertion face and the particles not yet released.
+    pub stream: Option<Box<StreamFace>>,
     span: Span,
+}
+
+/// Where an insert/stream particle started and when it is released.
+#[derive(Clone, Copy, Debug)]
+pub struct Release {
+    /// Position at insertion.
+    pub x0: V3,
+    /// Insertion step.
+    pub i_step: i64,
+    /// Release step (the particle reaches the face).
+    pub r_step: i64,
+}
+
+/// The insertion face of `fix insert/stream` and its release bookkeeping.
+#[derive(Clone, Debug)]
+pub struct StreamFace {
+    /// Id of the `fix mesh/surface` giving the face.
+    pub mesh_id: String,
+    /// Triangles of the face (world frame, file order).
+    pub tris: Vec<crate::geom::mesh::Triangle>,
+    /// Accumulated triangle areas.
+    pub area_acc: Vec<f64>,
+    /// Unit face normal, pointing along the insertion velocity.
+    pub normal: V3,
+    /// Insertion velocity projected on the normal (particles move with it until released).
+    pub v_normal: V3,
+    /// First node of the first triangle.
+    pub p_ref: V3,
+    /// Extrusion length of the face (upstream).
+    pub extrude: f64,
+    /// The mesh's own random stream (LIGGGHTS seeds every mesh with 179424799).
+    pub mesh_rng: Park,
+    /// The insertion fraction has been estimated once.
+    pub fraction_done: bool,
+    /// Fraction of the extruded volume inside the box.
+    pub fraction: f64,
+    /// Particles moving with v_normal, by tag.
+    pub release: std::collections::HashMap<i64, Release>,
+}
+
+/// LIGGGHTS `FIX_INSERT_STREAM_TINY`.
+const STREAM_TINY: f64 = 1e-14;
+
+impl StreamFace {
+    /// A random point on the face (LIGGGHTS `generateRandomOwnedGhost`).
+    fn face_point(&mut self) -> V3 {
+        let total = self.area_acc.last().copied().unwrap_or(0.0);
+        let r = self.mesh_rng.uniform() * total;
+        let k = self.area_acc.partition_point(|a| *a < r).min(self.tris.len().saturating_sub(1));
+        let (mut u, mut v);
+        loop {
+            u = self.mesh_rng.uniform();
+            v = self.mesh_rng.uniform();
+            if u + v <= 1.0 {
+                break;
+            }
+        }
+        let t = &self.tris[k].v;
+        (1.0 - u - v) * t[0] + v * t[1] + u * t[2]
+    }
+}
+
+/// Whether `x` is in the box and at least `r` from its faces (LIGGGHTS
+/// `is_in_subdomain` and `dist_subbox_borders`, one process).
+fn in_box_away(d: &Domain, x: &V3, r: f64) -> bool {
+    in_box(d, x) && (0..3).all(|k| (d.lo[k] - x[k]).abs() >= r && (d.hi[k] - x[k]).abs() >= r)
 }
 
 fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args) -> Result<LiggghtsInsert> {
     let st = style.text.clone();
     let pack = st == "insert/pack";
+    let is_stream = st == "insert/stream";
+    let mut face: Option<(SharedMesh, Span)> = None;
+    let mut extrude_length = 0.0;
+    let mut duration = 0i64;
     s.need_box(a.cmd)?;
     if s.dimension != 3 {
         return Err(Error::deck(style.span, lig(&st, id, "Can use fix insert for 3d simulations only")));
@@ -515,6 +718,7 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
         "set_property", "compress_tags",
     ];
     const PACK: &[&str] = &["region", "volumefraction_region", "particles_in_region", "mass_in_region", "ntry_mc", "warn_region", "check_dist_from_subdomain_border"];
+    const STREAM: &[&str] = &["insertion_face", "extrude_length", "duration", "parallel", "ntry_mc"];
     while a.more() {
         let k = a.word("keyword")?;
         let kt = k.text.as_str();
@@ -523,10 +727,42 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
             return Err(Error::deck(k.span, lig(&st, id, m))
                 .with_hint(format!("LIGGGHTS reads '{kt}' only before the region keywords ({})", PACK.join(", "))));
         }
-        if PACK.contains(&kt) {
+        if PACK.contains(&kt) || (is_stream && STREAM.contains(&kt)) {
             phase2 = true;
         }
+        if is_stream && PACK.contains(&kt) && !STREAM.contains(&kt) {
+            return Err(Error::deck(k.span, lig(&st, id, "unknown keyword")).with_hint(format!("insert/stream keywords: {}", STREAM.join(", "))));
+        }
         match kt {
+            "insertion_face" if is_stream => {
+                let w = a.word("mesh id")?;
+                let f = s.sim.fixes.iter().find(|f| f.id() == w.text);
+                match f {
+                    None => return Err(Error::deck(w.span, lig(&st, id, "Could not find fix mesh/gran id you provided"))),
+                    Some(f) if !f.style().starts_with("mesh") => {
+                        return Err(Error::deck(w.span, lig(&st, id, "The fix belonging to the id you provided is not of type mesh")))
+                    }
+                    _ => {}
+                }
+                let m = super::mesh::find_mesh(s, &w.text)
+                    .ok_or_else(|| Error::deck(w.span, lig(&st, id, "The fix belonging to the id you provided is not of type mesh")))?;
+                face = Some((m, w.span));
+            }
+            "extrude_length" if is_stream => {
+                extrude_length = a.f64("extrude_length")?;
+                if extrude_length < 0.0 {
+                    return Err(a.err_prev(lig(&st, id, "invalid extrude_length")));
+                }
+            }
+            "duration" if is_stream => {
+                duration = a.i64("duration")?;
+                if duration < 1 {
+                    return Err(a.err_prev(lig(&st, id, "'duration' can not be < 1")));
+                }
+            }
+            "parallel" if is_stream => {
+                a.yes_no("parallel")?;
+            }
             "distributiontemplate" => {
                 let w = a.word("distribution id")?;
                 let d = s
@@ -662,7 +898,7 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
             }
             _ => {
                 let mut all: Vec<&str> = BASE.to_vec();
-                all.extend_from_slice(PACK);
+                all.extend_from_slice(if is_stream { STREAM } else { PACK });
                 return Err(bad_keyword(k, &format!("{st} keyword"), &all));
             }
         }
@@ -688,6 +924,23 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
     }
     if nflowrate > 0.0 && massflowrate > 0.0 {
         return Err(Error::deck(style.span, lig(&st, id, "must not define both 'particlerate' and 'massrate'")));
+    }
+    let mut stream = None;
+    let mut insert_every = insert_every;
+    if is_stream {
+        let (f, sp, ie) = stream_face(s, &st, id, face, vel.1, extrude_length, duration, insert_every, &dist, style.span)?;
+        insert_every = Some(ie);
+        region = Some(Region {
+            id: f.mesh_id.clone(),
+            shape: Shape::Block { lo: sp.0, hi: sp.1 },
+            interior: true,
+            open: [false; 6],
+            motion: None,
+            disp: V3::zeros(),
+            angle: 0.0,
+            box_bounds: None,
+        });
+        stream = Some(Box::new(f));
     }
     let insert_every = insert_every.ok_or_else(|| Error::deck(style.span, lig(&st, id, "must define 'insert_every'")))?;
     if insert_every == 0 && (nflowrate > 0.0 || massflowrate > 0.0) {
@@ -757,8 +1010,115 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
         region_volume: None,
         ninserted: 0,
         mass_inserted: 0.0,
+        stream,
         span: style.span,
     })
+}
+
+/// Check the insertion face of insert/stream and derive its geometry
+/// (LIGGGHTS `calc_insertion_properties`): the face, the extruded volume's
+/// bounding box and insert_every.
+#[allow(clippy::too_many_arguments)]
+fn stream_face(
+    s: &Session,
+    st: &str,
+    id: &str,
+    face: Option<(SharedMesh, Span)>,
+    v_insert: V3,
+    extrude_length: f64,
+    duration: i64,
+    insert_every: Option<i64>,
+    dist: &Distribution,
+    span: Span,
+) -> Result<(StreamFace, (V3, V3), i64)> {
+    let (mesh, mspan) = face.ok_or_else(|| Error::deck(span, lig(st, id, "must define an insertion face")))?;
+    let m = mesh.read().map_err(|_| Error::runtime("mesh state poisoned by an earlier failure"))?;
+    if m.tris.is_empty() {
+        return Err(Error::deck(mspan, lig(st, id, "the insertion face has no triangles")));
+    }
+    if !m.is_planar() {
+        return Err(Error::deck(mspan, lig(st, id, "command requires a planar face for insertion")));
+    }
+    if m.motion.is_some() {
+        return Err(Error::deck(mspan, lig(st, id, "cannot translate, rotate, scale mesh which is used for particle insertion")));
+    }
+    let tris = m.tris.clone();
+    let mut normal = tris[0].n;
+    if v_insert.dot(&normal) < 0.0 {
+        normal = -normal;
+    }
+    let v_normal = normal * v_insert.dot(&normal);
+    if v_normal.norm() < 1e-3 {
+        return Err(Error::deck(span, lig(st, id, "insertion velocity projected on face normal is < 1e-3")));
+    }
+    if v_insert.norm() < 1e-5 {
+        return Err(Error::deck(span, lig(st, id, "insertion velocity too low")));
+    }
+    if insert_every.is_none() && extrude_length == 0.0 {
+        return Err(Error::deck(span, lig(st, id, "must define either 'insert_every' or 'extrude_length'")));
+    }
+    if insert_every.is_some() && extrude_length > 0.0 {
+        return Err(Error::deck(span, lig(st, id, "must not provide both 'insert_every' and 'extrude_length'")));
+    }
+    if extrude_length > 0.0 && duration > 0 {
+        return Err(Error::deck(span, lig(st, id, "must not provide both 'extrude_length' and 'duration'")));
+    }
+    let dt = s.sim.dt;
+    let rmax = dist.max_radius();
+    let (every, extrude) = match insert_every {
+        None => {
+            if extrude_length < 3.0 * rmax {
+                return Err(Error::deck(span, lig(st, id, "'extrude_length' is too small"))
+                    .with_hint(format!("it must be at least 3 x the largest radius ({})", 3.0 * rmax)));
+            }
+            let e = ((extrude_length + STREAM_TINY) / (dt * v_normal.norm())) as i64;
+            if e == 0 {
+                return Err(Error::deck(span, lig(st, id, "insertion velocity too high or extrude_length too low")));
+            }
+            (e, extrude_length)
+        }
+        Some(e) => {
+            if e < 1 {
+                return Err(Error::deck(span, lig(st, id, "'insert_every' must be > 0")));
+            }
+            let d = if duration == 0 { e } else { duration };
+            if d > e {
+                return Err(Error::deck(span, lig(st, id, "'duration' > 'insert_every' not allowed")));
+            }
+            let x = d as f64 * dt * v_normal.norm();
+            if x < 3.0 * rmax {
+                return Err(Error::deck(span, lig(st, id, "'insert_every' or 'vel' is too small, or radius of inserted particles too large")));
+            }
+            (e, x)
+        }
+    };
+    let mut area_acc = Vec::with_capacity(tris.len());
+    let mut acc = 0.0;
+    let (mut lo, mut hi) = (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY));
+    for t in &tris {
+        acc += t.area();
+        area_acc.push(acc);
+        for v in &t.v {
+            lo = lo.inf(v);
+            hi = hi.sup(v);
+        }
+    }
+    let ext = -extrude * normal;
+    let (lo2, hi2) = (lo.inf(&(lo + ext)), hi.sup(&(hi + ext)));
+    let f = StreamFace {
+        mesh_id: m.id.clone(),
+        p_ref: tris[0].v[0],
+        tris,
+        area_acc,
+        normal,
+        v_normal,
+        extrude,
+        mesh_rng: Park::new(179424799),
+        fraction_done: false,
+        fraction: 1.0,
+        release: Default::default(),
+    };
+    Ok((f, (lo2, hi2), every))
 }
 
 /// C `%e`.
@@ -854,6 +1214,154 @@ impl LiggghtsInsert {
         }
     }
 
+    /// One insert/stream insertion (LIGGGHTS `FixInsert::pre_exchange` with
+    /// the stream's `x_v_omega` and `finalize_insertion`).
+    fn stream_insert(&mut self, sim: &mut Sim, domain: &Domain) -> Result<()> {
+        let Some(mut f) = self.stream.take() else { return Ok(()) };
+        let r = self.stream_insert_with(sim, domain, &mut f);
+        self.stream = Some(f);
+        r
+    }
+
+    fn stream_insert_with(&mut self, sim: &mut Sim, domain: &Domain, f: &mut StreamFace) -> Result<()> {
+        let (mut n, _) = self.count(sim)?;
+        let mut exact = self.exact;
+        if let InsertMode::Rate { ninsert: Some(t), .. } = self.mode {
+            if self.ninserted + n >= t {
+                n = (t - self.ninserted).max(0);
+                exact = true;
+            }
+        }
+        // insertion fraction: first time, and every time on a shrink-wrapped box
+        let shrink = domain.sides.iter().any(|s| s.iter().any(|x| *x == crate::engine::domain::Side::Shrink));
+        if !f.fraction_done || shrink {
+            f.fraction_done = true;
+            let mut nin = 0usize;
+            for _ in 0..self.ntry_mc {
+                let mut x = f.face_point();
+                x -= f.normal * (self.rng.uniform() * f.extrude);
+                if in_box(domain, &x) {
+                    nin += 1;
+                }
+            }
+            f.fraction = nin as f64 / self.ntry_mc.max(1) as f64;
+        }
+        if !exact {
+            n = (f.fraction * n as f64 + self.rng.uniform()) as i64;
+        } else if f.fraction < 0.02 {
+            return Err(Error::runtime(format!("fix {} {}: the extruded insertion face lies outside the box", self.style, self.id)));
+        }
+        let list = self.dist.split(n.max(0) as usize, exact);
+        let want = list.len();
+        if want == 0 {
+            sim.log.line("WARNING: Particle insertion: Inserting no particle - check particle insertion settings");
+            let more = match self.mode {
+                InsertMode::Rate { ninsert: Some(t), .. } => self.ninserted < t,
+                _ => true,
+            };
+            self.next = if more { self.next.map(|s| s + self.insert_every) } else { None };
+            return Ok(());
+        }
+        let maxtry = want as i64 * self.maxattempt;
+        let rmax_new = self.dist.max_radius();
+        let p = &sim.particles;
+        let rmax_old = p.radius.iter().copied().fold(0.0, f64::max);
+        let mut grid = OverlapGrid::new(rmax_new + rmax_old.max(rmax_new), Some(domain));
+        if self.overlap {
+            for i in 0..p.len() {
+                grid.add(p.x[i], p.radius[i]);
+            }
+        }
+        let extrude = f.extrude;
+        let gen = |f: &mut StreamFace, rng: &mut Park, rad: f64, ol: bool| {
+            let x = f.face_point();
+            let r = if ol { rng.uniform() * extrude + rad } else { rng.uniform() * (extrude - 2.0 * rad) + rad };
+            x - f.normal * r
+        };
+        let mut placed: Vec<(usize, V3)> = Vec::new();
+        let mut ntry = 0i64;
+        if !self.overlap {
+            for _ in 0..want {
+                let k = list[placed.len()];
+                let rad = self.dist.templates[k].radius;
+                let mut x;
+                loop {
+                    x = gen(f, &mut self.rng, rad, false);
+                    ntry += 1;
+                    if !(ntry < maxtry && !in_box_away(domain, &x, rad)) {
+                        break;
+                    }
+                }
+                if ntry < maxtry {
+                    placed.push((k, x));
+                }
+            }
+        } else {
+            while ntry < maxtry && placed.len() < want {
+                let k = list[placed.len()];
+                let rad = self.dist.templates[k].radius;
+                let mut ok = false;
+                while !ok && ntry < maxtry {
+                    let mut x;
+                    loop {
+                        x = gen(f, &mut self.rng, rad, true);
+                        ntry += 1;
+                        if !(ntry < maxtry && !in_box_away(domain, &x, rad)) {
+                            break;
+                        }
+                    }
+                    if ntry < maxtry && !grid.overlaps(x, rad) {
+                        grid.add(x, rad);
+                        placed.push((k, x));
+                        ok = true;
+                    }
+                }
+            }
+        }
+        let mut tag = sim.particles.max_tag();
+        let mut mass_now = 0.0;
+        let speed = f.v_normal.norm();
+        for &(k, x) in &placed {
+            let t = &self.dist.templates[k];
+            tag += 1;
+            sim.particles.push(NewParticle {
+                tag,
+                kind: t.kind,
+                mask: 1 | self.group | self.dist.group | t.group,
+                x,
+                v: f.v_normal,
+                omega: V3::zeros(),
+                radius: t.radius,
+                density: t.density,
+            });
+            mass_now += t.mass();
+            let dist_normal = (f.p_ref - x).dot(&f.normal);
+            let n_steps = ((dist_normal + STREAM_TINY) / (speed * sim.dt)) as i64;
+            f.release.insert(tag, Release { x0: x, i_step: sim.step, r_step: sim.step + n_steps });
+        }
+        sim.force_rebuild = true;
+        self.ninserted += placed.len() as i64;
+        self.mass_inserted += mass_now;
+        sim.log.line(&format!(
+            "INFO: Particle insertion {}: inserted {} particle templates (mass {}) at step {}\n - a total of {} particle templates (mass {}) inserted so far.",
+            self.id,
+            placed.len(),
+            fmt_e(mass_now),
+            sim.step,
+            self.ninserted,
+            fmt_e(self.mass_inserted)
+        ));
+        if placed.len() < want {
+            sim.log.line("WARNING: Particle insertion: Less insertions than requested");
+        }
+        let more = match self.mode {
+            InsertMode::Rate { ninsert: Some(t), .. } => self.ninserted < t,
+            _ => true,
+        };
+        self.next = if more { self.next.map(|s| s + self.insert_every) } else { None };
+        Ok(())
+    }
+
     /// Number to insert now and the insertion ratio (pack) (LIGGGHTS `calc_ninsert_this`).
     fn count(&mut self, sim: &Sim) -> Result<(i64, f64)> {
         let p = &sim.particles;
@@ -904,7 +1412,9 @@ impl Fix for LiggghtsInsert {
             }
         }
         if let Some(d) = sim.domain.clone() {
-            self.volume(&d)?;
+            if self.stream.is_none() {
+                self.volume(&d)?;
+            }
         }
         if let InsertMode::Rate { nflowrate, ninsert_per, .. } = &mut self.mode {
             *ninsert_per = *nflowrate * self.insert_every as f64 * sim.dt;
@@ -919,6 +1429,9 @@ impl Fix for LiggghtsInsert {
             return Ok(());
         }
         let Some(domain) = sim.domain.clone() else { return Ok(()) };
+        if self.stream.is_some() {
+            return self.stream_insert(sim, &domain);
+        }
         self.volume(&domain)?;
         // region outside the box with a fixed boundary
         if let Some((lo, hi)) = self.region.bbox() {
@@ -1022,6 +1535,40 @@ impl Fix for LiggghtsInsert {
             _ => true,
         };
         self.next = if self.insert_every > 0 && more { self.next.map(|s| s + self.insert_every) } else { None };
+        Ok(())
+    }
+    fn end_of_step(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
+        let Some(mut f) = self.stream.take() else { return Ok(()) };
+        if !f.release.is_empty() {
+            let step = sim.step;
+            let dt = sim.dt;
+            for i in 0..sim.particles.len() {
+                if sim.particles.mask[i] & self.group == 0 {
+                    continue;
+                }
+                let tag = sim.particles.tag[i];
+                let Some(r) = f.release.get(&tag).copied() else { continue };
+                if step > r.r_step {
+                    f.release.remove(&tag);
+                    continue;
+                }
+                let p = &mut sim.particles;
+                p.x[i] = r.x0 + f.v_normal * ((step - r.i_step) as f64 * dt);
+                p.f[i] = V3::zeros();
+                p.torque[i] = V3::zeros();
+                if step == r.r_step {
+                    f.release.remove(&tag);
+                    let v = self.draw_velocity();
+                    let p = &mut sim.particles;
+                    p.v[i] = v;
+                    p.omega[i] = self.omega;
+                } else {
+                    p.v[i] = f.v_normal;
+                    p.omega[i] = V3::zeros();
+                }
+            }
+        }
+        self.stream = Some(f);
         Ok(())
     }
     fn vector(&self, _sim: &Sim, i: usize) -> Option<f64> {

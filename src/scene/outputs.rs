@@ -223,12 +223,29 @@ impl Dump for DumpText {
             return Ok(());
         }
         self.last_step = Some(sim.step);
-        let p = &sim.particles;
-        let rows: Vec<usize> = (0..p.len()).filter(|&i| p.mask[i] & self.group != 0).collect();
         let input_cols: Vec<String> = match self.opts.style {
             crate::io::dump::DumpStyle::Custom => self.columns.clone(),
             crate::io::dump::DumpStyle::Atom => ["id", "type", "x", "y", "z", "ix", "iy", "iz"].iter().map(|s| s.to_string()).collect(),
         };
+        let frame = make_frame(sim, self.group, input_cols)?;
+        self.ensure_open()?.write_frame(&frame)
+    }
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn modify(&mut self, args: &[crate::script::Word]) -> Result<()> {
+        self.modify_opts(args)
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+}
+
+/// The frame of group `group` with the given columns at the current step.
+fn make_frame(sim: &Sim, group: u32, input_cols: Vec<String>) -> Result<Frame> {
+    {
+        let p = &sim.particles;
+        let rows: Vec<usize> = (0..p.len()).filter(|&i| p.mask[i] & group != 0).collect();
         let mut values = Vec::with_capacity(rows.len() * input_cols.len());
         let mut col_vals: Vec<Vec<f64>> = Vec::with_capacity(input_cols.len());
         for c in &input_cols {
@@ -242,13 +259,72 @@ impl Dump for DumpText {
         let d = sim.domain.as_ref().ok_or_else(|| Error::runtime("dump before the box exists"))?;
         let b = d.boundary_strings();
         let bounds = crate::io::dump::BoxBounds::orthogonal(d.lo, d.hi, &format!("{} {} {}", b[0], b[1], b[2]));
-        let frame = Frame { timestep: sim.step.max(0) as u64, time: Some(sim.time), natoms: rows.len(), bounds, columns: input_cols, values };
-        self.ensure_open()?.write_frame(&frame)
+        Ok(Frame { timestep: sim.step.max(0) as u64, time: Some(sim.time), natoms: rows.len(), bounds, columns: input_cols, values })
+    }
+}
+
+/// LIGGGHTS `dump custom/vtk`: one legacy VTK file per frame (`*` in the
+/// name becomes the step) plus the `*_boundingBox_*` file of the box.
+pub struct DumpVtk {
+    id: String,
+    group: u32,
+    columns: Vec<String>,
+    every: i64,
+    first: bool,
+    path: String,
+    last_step: Option<i64>,
+    summary: String,
+}
+
+impl Dump for DumpVtk {
+    fn due(&self, step: i64, first: bool) -> bool {
+        if self.last_step == Some(step) {
+            return false;
+        }
+        (self.every > 0 && step % self.every == 0) || (first && self.first)
+    }
+    fn write(&mut self, sim: &Sim) -> Result<()> {
+        if sim.dry {
+            return Ok(());
+        }
+        self.last_step = Some(sim.step);
+        let frame = make_frame(sim, self.group, self.columns.clone())?;
+        let file = self.path.replace('*', &sim.step.to_string());
+        crate::io::vtk::write_particles_vtk(&file, &frame)?;
+        if self.path.contains('*') {
+            if let Some(d) = &sim.domain {
+                let bb = self.path.replace('*', &format!("boundingBox_{}", sim.step));
+                let text = crate::io::vtk::format_bounding_box_vtk([d.lo[0], d.lo[1], d.lo[2]], [d.hi[0], d.hi[1], d.hi[2]]);
+                std::fs::write(&bb, text).map_err(|e| Error::io(crate::script::Span::DUMMY, format!("cannot write '{bb}'"), &e))?;
+            }
+        }
+        Ok(())
     }
     fn id(&self) -> &str {
         &self.id
     }
     fn modify(&mut self, args: &[crate::script::Word]) -> Result<()> {
+        let mut k = 0;
+        while k < args.len() {
+            let w = &args[k];
+            let v = args.get(k + 1).ok_or_else(|| Error::deck(w.span, format!("dump_modify {}: missing value", w.text)))?;
+            match w.text.as_str() {
+                "first" => self.first = matches!(v.text.as_str(), "yes" | "on"),
+                "every" => self.every = super::args::parse_i64(v)?.max(0),
+                "sort" | "flush" | "pad" | "precision" | "binary" | "label" | "compressor" | "format" => {}
+                _ => return Err(Error::unsupported(w.span, format!("dump_modify {} for dump custom/vtk", w.text))),
+            }
+            k += 2;
+        }
+        Ok(())
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+}
+
+impl DumpText {
+    fn modify_opts(&mut self, args: &[crate::script::Word]) -> Result<()> {
         let mut k = 0;
         while k < args.len() {
             let w = &args[k];
@@ -332,9 +408,6 @@ impl Dump for DumpText {
         }
         Ok(())
     }
-    fn summary(&self) -> String {
-        self.summary.clone()
-    }
 }
 
 fn column_values(sim: &Sim, c: &str) -> Result<Vec<f64>> {
@@ -358,7 +431,7 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     let file = a.word("file")?;
     let engine = if s.sim.dialect == Dialect::Liggghts { Engine::Liggghts } else { Engine::Lammps };
     let (opts, columns) = match style.text.as_str() {
-        "custom" | "custom/gz" => {
+        "custom" | "custom/gz" | "custom/vtk" => {
             let mut cols = vec![];
             for w in a.rest() {
                 let t = w.text.as_str();
@@ -392,12 +465,21 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             s.sim.dumps.push(Box::new(d));
             return Ok(());
         }
-        "custom/vtk" | "mesh/vtk" | "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "stl" | "mesh/gran/VTK" | "vtk" | "decomposition/vtk" | "euler/vtk" => {
+        "mesh/vtk" | "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "stl" | "mesh/gran/VTK" | "vtk" | "decomposition/vtk" | "euler/vtk" => {
             return Err(Error::unsupported(style.span, format!("dump {}", style.text)));
         }
         _ => return Err(bad_keyword(style, "dump style", &["custom", "atom", "custom/vtk", "mesh/stl"])),
     };
     let summary = format!("dump {} {} every {} -> {}", id.text, style.text, every, file.text);
+    if s.sim.dumps.iter().any(|x| x.id() == id.text) {
+        return Err(Error::deck(id.span, format!("dump '{}' already exists", id.text)).with_hint("undump it first"));
+    }
+    if style.text == "custom/vtk" {
+        crate::io::vtk::vtk_fields(&columns).map_err(|_| Error::deck(style.span, "dump custom/vtk needs the columns x y z"))?;
+        let d = DumpVtk { id: id.text.clone(), group, columns, every, first: false, path: file.text.clone(), last_step: None, summary };
+        s.sim.dumps.push(Box::new(d));
+        return Ok(());
+    }
     let d = DumpText { id: id.text.clone(), group, columns, writer: None, opts, path: file.text.clone(), last_step: None, summary };
     if let Some(k) = s.sim.dumps.iter().position(|x| x.id() == id.text) {
         return Err(Error::deck(id.span, format!("dump '{}' already exists (k={k})", id.text)).with_hint("undump it first"));
