@@ -142,7 +142,6 @@ fn insert_stream_counts_release_and_vtk() {
 }
 
 #[test]
-#[ignore = "needs src/scene/model.rs to route `fix adapt` to setup::extended_fix (see the h-tut report)"]
 fn packing_grows_and_settles() {
     let vars = [("growts_n", "400"), ("relaxts_n", "400"), ("nthermo", "100")];
     let (ours, theirs, _tmp) = check_deck("packing", "in.packing", "liggghts", &vars);
