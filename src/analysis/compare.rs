@@ -642,10 +642,20 @@ pub fn render(c: &Comparison) -> String {
         o.push_str(&format!("({} of {} frames shown; --csv or --json for all)\n", n.div_ceil(step), n));
     }
     match c.divergence {
-        Some((t, id, e)) => o.push_str(&format!(
-            "divergence: first frame beyond tolerance at timestep {t} (particle {}, {e:.3e} diameters)\n",
-            opt_id(id)
-        )),
+        Some((t, id, e)) => {
+            let f = c.frames.iter().find(|f| f.timestep == t);
+            o.push_str(&format!(
+                "divergence: first frame beyond tolerance at timestep {t} (particle {}, {e:.3e} diameters{})\n",
+                opt_id(id),
+                f.map_or(String::new(), |f| format!(
+                    "; velocity {:.3e} (particle {}), omega {:.3e} (particle {}) relative",
+                    f.vel_rel,
+                    opt_id(f.vel_max_id),
+                    f.omega_rel,
+                    opt_id(f.omega_max_id)
+                ))
+            ))
+        }
         None => o.push_str("divergence: none (every common frame within the trajectory tolerances)\n"),
     }
     o.push_str(&format!(
