@@ -1,6 +1,8 @@
 //! Measurements on runs: comparison with the reference engines, angle of
 //! repose, packing fraction, aeolian transport, cost-accuracy trade-offs.
 pub mod compare;
+pub mod compare_deck;
+pub mod compare_stats;
 pub mod reference;
 pub mod repose;
 pub mod packing;
