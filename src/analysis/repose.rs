@@ -1,10 +1,215 @@
-//! `demx repose` (not implemented yet).
+//! `demx repose DUMP [--frame N] [--json]`: the angle of repose of a heap the
+//! way Elekes & Parteli (2021, PNAS, Fig. 1) measure it. For each side
+//! projection (x-z and y-z) the heap's upper boundary is found by
+//! rasterising the spheres (each column of the raster takes the highest
+//! sphere surface above it); the heap base is the contiguous stretch of
+//! non-empty columns around the crest; theta is the base angle of the
+//! isosceles triangle with the same area over that base,
+//! theta = atan(4 A / B^2). The result is the mean and SD of the two
+//! projections, with the Bond number Bo = 12 gamma / (d^2 g rho) (paper,
+//! after Eq. 3) and the regime: irregular heaps (regime I) above Bo ~ 1e4.
 
+use crate::error::{Error, Result};
+use crate::io::dump::{DumpReader, Frame};
 use std::process::ExitCode;
+
+/// Angle of repose of one heap.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Repose {
+    /// Base angle in the x-z projection, degrees.
+    pub theta_xz: f64,
+    /// Base angle in the y-z projection, degrees.
+    pub theta_yz: f64,
+    /// Mean of the two, degrees.
+    pub theta: f64,
+    /// Sample standard deviation of the two, degrees.
+    pub sd: f64,
+    /// Heap height over the plate (highest sphere surface), m.
+    pub height: f64,
+    /// Particles used.
+    pub particles: usize,
+    /// Mean particle diameter, m.
+    pub diameter: f64,
+}
+
+/// Bond number of the paper, Bo = 12 gamma / (d^2 g rho).
+pub fn bond_number(gamma: f64, d: f64, g: f64, rho: f64) -> f64 {
+    12.0 * gamma / (d * d * g * rho)
+}
+
+/// The paper's heap regime for a Bond number.
+pub fn regime(bo: f64) -> &'static str {
+    if bo > 1e4 {
+        "irregular heap (regime I, Bo > ~1e4): Eq. 1 does not apply"
+    } else {
+        "regular heap (regime II)"
+    }
+}
+
+/// Base angle (degrees) of the isosceles triangle with the area of the
+/// upper boundary of spheres (horizontal centre `h`, height `z` above the
+/// plate, radius `r`) in one side projection, rasterised with `pixel`
+/// wide columns. None without particles.
+pub fn projection_angle(h: &[f64], z: &[f64], r: &[f64], pixel: f64) -> Option<f64> {
+    if h.is_empty() || !(pixel > 0.0) {
+        return None;
+    }
+    let lo = h.iter().zip(r).map(|(a, b)| a - b).fold(f64::INFINITY, f64::min);
+    let hi = h.iter().zip(r).map(|(a, b)| a + b).fold(f64::NEG_INFINITY, f64::max);
+    let n = ((hi - lo) / pixel).ceil() as usize + 1;
+    if !(n < 50_000_000) {
+        return None;
+    }
+    let mut top = vec![0.0_f64; n];
+    for k in 0..h.len() {
+        let (c, zc, rad) = (h[k], z[k], r[k]);
+        let i0 = ((c - rad - lo) / pixel).floor().max(0.0) as usize;
+        let i1 = (((c + rad - lo) / pixel).ceil() as usize).min(n - 1);
+        for (i, t) in top.iter_mut().enumerate().take(i1 + 1).skip(i0) {
+            let x = lo + (i as f64 + 0.5) * pixel - c;
+            if x.abs() < rad {
+                let s = zc + (rad * rad - x * x).sqrt();
+                if s > *t {
+                    *t = s;
+                }
+            }
+        }
+    }
+    let crest = top.iter().enumerate().fold(0, |b, (i, &v)| if v > top[b] { i } else { b });
+    let mut a = crest;
+    while a > 0 && top[a - 1] > 0.0 {
+        a -= 1;
+    }
+    let mut b = crest;
+    while b + 1 < n && top[b + 1] > 0.0 {
+        b += 1;
+    }
+    let base = (b - a + 1) as f64 * pixel;
+    let area: f64 = top[a..=b].iter().sum::<f64>() * pixel;
+    Some((4.0 * area / (base * base)).atan().to_degrees())
+}
+
+fn column(f: &Frame, names: &[&str]) -> Option<Vec<f64>> {
+    names.iter().find_map(|n| f.column(n))
+}
+
+/// Radii of a frame (`radius`, or `diameter`/2); error when neither is dumped.
+pub(crate) fn radii(f: &Frame) -> Result<Vec<f64>> {
+    if let Some(r) = f.column("radius") {
+        return Ok(r);
+    }
+    if let Some(d) = f.column("diameter") {
+        return Ok(d.into_iter().map(|v| 0.5 * v).collect());
+    }
+    Err(Error::usage("the dump needs a radius or diameter column"))
+}
+
+/// Positions (x, y, z) of a frame, unscaled.
+pub(crate) fn positions(f: &Frame) -> Result<[Vec<f64>; 3]> {
+    let get = |a: &str, s: &str| -> Result<Vec<f64>> {
+        if let Some(v) = column(f, &[a, &format!("{a}u")]) {
+            return Ok(v);
+        }
+        let v = f.column(s).ok_or_else(|| Error::usage(format!("the dump needs {a} (or {s}) columns")))?;
+        let k = ["x", "y", "z"].iter().position(|c| *c == a).unwrap_or(0);
+        let (lo, hi) = (f.bounds.lo[k], f.bounds.hi[k]);
+        Ok(v.into_iter().map(|u| lo + u * (hi - lo)).collect())
+    };
+    Ok([get("x", "xs")?, get("y", "ys")?, get("z", "zs")?])
+}
+
+/// Angle of repose of the heap in `f`; the plate is the lowest sphere bottom.
+pub fn repose(f: &Frame) -> Result<Repose> {
+    let [x, y, z] = positions(f)?;
+    let r = radii(f)?;
+    if r.is_empty() {
+        return Err(Error::usage("the frame has no particles"));
+    }
+    let plate = z.iter().zip(&r).map(|(a, b)| a - b).fold(f64::INFINITY, f64::min);
+    let zh: Vec<f64> = z.iter().map(|v| v - plate).collect();
+    let rmin = r.iter().cloned().fold(f64::INFINITY, f64::min);
+    let pixel = rmin / 5.0;
+    let txz = projection_angle(&x, &zh, &r, pixel).ok_or_else(|| Error::usage("cannot rasterise the x-z projection"))?;
+    let tyz = projection_angle(&y, &zh, &r, pixel).ok_or_else(|| Error::usage("cannot rasterise the y-z projection"))?;
+    let theta = 0.5 * (txz + tyz);
+    let sd = (txz - tyz).abs() / std::f64::consts::SQRT_2;
+    let height = zh.iter().zip(&r).map(|(a, b)| a + b).fold(0.0, f64::max);
+    let diameter = 2.0 * r.iter().sum::<f64>() / r.len() as f64;
+    Ok(Repose { theta_xz: txz, theta_yz: tyz, theta, sd, height, particles: r.len(), diameter })
+}
+
+/// Pick frame `index` (negative: from the end; default the last) of a dump.
+pub(crate) fn pick_frame(path: &str, index: Option<i64>) -> Result<Frame> {
+    let mut frames = vec![];
+    for f in DumpReader::open(path)? {
+        frames.push(f?);
+        if let Some(i) = index {
+            if i >= 0 && frames.len() as i64 > i {
+                break;
+            }
+        }
+    }
+    let n = frames.len() as i64;
+    let i = match index {
+        None => n - 1,
+        Some(i) if i < 0 => n + i,
+        Some(i) => i,
+    };
+    if i < 0 || i >= n {
+        return Err(Error::usage(format!("{path}: no frame {} ({n} frames)", index.unwrap_or(-1))));
+    }
+    Ok(frames.swap_remove(i as usize))
+}
+
+#[derive(clap::Parser, Debug)]
+#[command(name = "demx repose", about = "Angle of repose of a heap (Elekes & Parteli 2021)")]
+struct Cli {
+    /// LIGGGHTS/LAMMPS dump with x y z (or xs ys zs) and radius (or diameter).
+    dump: String,
+    /// Frame index (0-based; negative from the end; default: the last).
+    #[arg(long, allow_hyphen_values = true)]
+    frame: Option<i64>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Surface energy gamma (J/m^2) for the Bond number.
+    #[arg(long, default_value_t = 0.05)]
+    gamma: f64,
+    /// Gravity (m/s^2) for the Bond number.
+    #[arg(long, default_value_t = 9.81)]
+    g: f64,
+    /// Particle density (kg/m^3) for the Bond number.
+    #[arg(long, default_value_t = 2500.0)]
+    rho: f64,
+}
 
 /// Entry point: `args` are the words after the subcommand name.
 pub fn cli(args: Vec<String>) -> ExitCode {
-    let _ = args;
-    eprintln!("error: demx repose is not implemented yet");
-    ExitCode::from(3)
+    use clap::Parser;
+    let c = match Cli::try_parse_from(std::iter::once("demx repose".to_string()).chain(args)) {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+        }
+    };
+    let res = pick_frame(&c.dump, c.frame).and_then(|f| repose(&f));
+    match res {
+        Ok(r) => {
+            let bo = bond_number(c.gamma, r.diameter, c.g, c.rho);
+            if c.json {
+                let v = serde_json::json!({"repose": r, "bond_number": bo, "regime": regime(bo)});
+                println!("{v}");
+            } else {
+                println!("theta_r = {:.2} +- {:.2} deg (x-z {:.2}, y-z {:.2})", r.theta, r.sd, r.theta_xz, r.theta_yz);
+                println!("heap height {:.4e} m, {} particles, d = {:.4e} m", r.height, r.particles, r.diameter);
+                println!("Bond number Bo = 12 gamma/(d^2 g rho) = {bo:.4e}: {}", regime(bo));
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
 }

@@ -31,6 +31,8 @@ pub enum NormalSpec {
     LigHertz,
     /// LIGGGHTS `model hertz/stiffness`.
     LigHertzStiffness,
+    /// demx `model hertz/viscoelastic` (the angle-of-repose paper, Eq. 10).
+    PaperViscoelastic,
     /// LAMMPS `gran/hooke*`.
     GranHooke,
     /// LAMMPS `gran/hertz/history`.
@@ -47,6 +49,8 @@ pub enum TangentialSpec {
     LigNoHistory,
     /// LIGGGHTS `tangential history`.
     LigHistory,
+    /// demx `tangential history/paper` (the paper's Eq. 11).
+    PaperHistory,
     /// LAMMPS `gran/hooke` (no shear history).
     GranNoHistory,
     /// LAMMPS `gran/*/history`.
@@ -73,6 +77,8 @@ pub enum CohesionSpec {
         /// `tangential_reduce on`.
         tangential_reduce: bool,
     },
+    /// demx `cohesion vdw` (the paper's Hamaker force, Eqs. 13-14).
+    Vdw,
 }
 
 /// Rolling law.
@@ -94,6 +100,11 @@ pub enum RollingSpec {
     },
     /// LIGGGHTS `rolling_friction epsd3`.
     Epsd3 {
+        /// `torsionTorque on`.
+        torsion: bool,
+    },
+    /// demx `rolling_friction epsd/paper` (the paper's Eq. 15).
+    PaperEpsd {
         /// `torsionTorque on`.
         torsion: bool,
     },
@@ -132,6 +143,23 @@ pub struct PairSpec {
 }
 
 impl PairSpec {
+    /// Model keywords of this spec that only demx knows (the paper's laws).
+    pub fn demx_extensions(&self) -> Vec<&'static str> {
+        let mut v = vec![];
+        if self.normal == NormalSpec::PaperViscoelastic {
+            v.push("model hertz/viscoelastic");
+        }
+        if self.tangential == TangentialSpec::PaperHistory {
+            v.push("tangential history/paper");
+        }
+        if self.cohesion == CohesionSpec::Vdw {
+            v.push("cohesion vdw");
+        }
+        if let RollingSpec::PaperEpsd { .. } = self.rolling {
+            v.push("rolling_friction epsd/paper");
+        }
+        v
+    }
     /// `hertz + tangential history` etc.
     pub fn summary(&self) -> String {
         let n = match self.normal {
@@ -139,6 +167,7 @@ impl PairSpec {
             NormalSpec::LigHookeStiffness { .. } => "hooke/stiffness (LIGGGHTS)".into(),
             NormalSpec::LigHertz => "hertz (LIGGGHTS)".into(),
             NormalSpec::LigHertzStiffness => "hertz/stiffness (LIGGGHTS)".into(),
+            NormalSpec::PaperViscoelastic => "hertz/viscoelastic (demx, paper Eq. 10)".into(),
             NormalSpec::GranHooke => "hooke (LAMMPS gran)".into(),
             NormalSpec::GranHertz => "hertz (LAMMPS gran)".into(),
             NormalSpec::Granular(m, d) => format!("{m:?} damping {d:?} (LAMMPS granular)").to_lowercase(),
@@ -146,12 +175,14 @@ impl PairSpec {
         let t = match self.tangential {
             TangentialSpec::LigNoHistory | TangentialSpec::GranNoHistory | TangentialSpec::LinearNoHistory => "tangential no_history".to_string(),
             TangentialSpec::LigHistory | TangentialSpec::GranHistory => "tangential history".into(),
+            TangentialSpec::PaperHistory => "tangential history/paper".into(),
             TangentialSpec::Granular(g) => format!("tangential {g:?}").to_lowercase(),
         };
         let c = match self.cohesion {
             CohesionSpec::Off => "none".to_string(),
             CohesionSpec::Sjkr { .. } => "sjkr".into(),
             CohesionSpec::Sjkr2 { .. } => "sjkr2".into(),
+            CohesionSpec::Vdw => "vdw".into(),
         };
         let r = match self.rolling {
             RollingSpec::Off => "none".to_string(),
@@ -159,6 +190,7 @@ impl PairSpec {
             RollingSpec::Epsd { .. } => "epsd".into(),
             RollingSpec::Epsd2 { .. } => "epsd2".into(),
             RollingSpec::Epsd3 { .. } => "epsd3".into(),
+            RollingSpec::PaperEpsd { .. } => "epsd/paper".into(),
             RollingSpec::Sds { twisting } => if twisting { "sds + twisting sds".into() } else { "sds".into() },
         };
         format!("{n} + {t}; cohesion: {c}; rolling: {r}")
@@ -180,6 +212,7 @@ pub fn build_kernel(spec: &PairSpec) -> Result<Box<dyn ContactKernel>> {
         }
         NormalSpec::LigHertz => lig_tangential(normal::hertz::LiggghtsHertz, spec),
         NormalSpec::LigHertzStiffness => lig_tangential(normal::hertz_stiffness::LiggghtsHertzStiffness, spec),
+        NormalSpec::PaperViscoelastic => lig_tangential(normal::viscoelastic::PaperViscoelastic, spec),
         NormalSpec::GranHooke => lmp_tangential(normal::gran::LammpsGranHooke, spec),
         NormalSpec::GranHertz => lmp_tangential(normal::gran::LammpsGranHertz, spec),
         NormalSpec::Granular(model, damping) => lmp_tangential(normal::granular::LammpsGranular { model, damping }, spec),
@@ -191,6 +224,7 @@ fn lig_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Optio
     match spec.tangential {
         TangentialSpec::LigNoHistory => lig_cohesion(n, tangential::no_history::LiggghtsNoHistory, spec),
         TangentialSpec::LigHistory => lig_cohesion(n, tangential::history::LiggghtsHistory, spec),
+        TangentialSpec::PaperHistory => lig_cohesion(n, tangential::paper::PaperCundallStrack, spec),
         _ => None,
     }
 }
@@ -201,6 +235,7 @@ fn lig_cohesion<N: NormalLaw + Send + 'static, T: TangentialLaw + Send + 'static
         CohesionSpec::Off => lig_rolling(n, t, NoCohesion, spec),
         CohesionSpec::Sjkr { tangential_reduce } => lig_rolling(n, t, LiggghtsSjkr { tangential_reduce }, spec),
         CohesionSpec::Sjkr2 { tangential_reduce } => lig_rolling(n, t, LiggghtsSjkr2 { tangential_reduce }, spec),
+        CohesionSpec::Vdw => lig_rolling(n, t, crate::physics::cohesion::vdw::Hamaker, spec),
     }
 }
 
@@ -217,6 +252,7 @@ where
         RollingSpec::Epsd { torsion } => finish(n, t, c, LiggghtsEpsd { torsion_torque: torsion }),
         RollingSpec::Epsd2 { torsion } => finish(n, t, c, LiggghtsEpsd2 { torsion_torque: torsion }),
         RollingSpec::Epsd3 { torsion } => finish(n, t, c, LiggghtsEpsd3 { torsion_torque: torsion }),
+        RollingSpec::PaperEpsd { torsion } => finish(n, t, c, crate::physics::rolling::paper::PaperEpsd { torsion_torque: torsion }),
         RollingSpec::Sds { .. } => return None,
     })
 }
@@ -315,6 +351,17 @@ pub fn execute(s: &mut Session, cmd: &Command) -> Result<()> {
         "gran" => {
             s.set_dialect(Dialect::Liggghts);
             parse_liggghts_model(&mut a, &mut spec)?;
+            let ext = spec.demx_extensions();
+            if !ext.is_empty() {
+                s.notes.push((
+                    cmd.span,
+                    format!(
+                        "pair_style gran: {} {} (Elekes & Parteli 2021 contact model); this deck runs in demx only, LIGGGHTS 3.8 and LAMMPS reject it",
+                        ext.join(", "),
+                        if ext.len() == 1 { "is a demx extension" } else { "are demx extensions" }
+                    ),
+                ));
+            }
         }
         "gran/hooke" | "gran/hooke/history" | "gran/hertz/history" => {
             let looks_legacy = a.rest().len() < 6 || a.rest().iter().take(6).any(|w| parse_f64(w).is_err() && w.text != "NULL");
@@ -395,10 +442,11 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
         "hooke/stiffness" => NormalSpec::LigHookeStiffness { absolute: false },
         "hertz" => NormalSpec::LigHertz,
         "hertz/stiffness" => NormalSpec::LigHertzStiffness,
+        "hertz/viscoelastic" => NormalSpec::PaperViscoelastic,
         "hooke/hysteresis" | "edinburgh" | "edinburgh/stiffness" | "luding" | "thornton_ning" => {
             return Err(Error::unsupported(m.span, format!("LIGGGHTS normal model '{}'", m.text)))
         }
-        _ => return Err(bad_keyword(m, "normal model", &["hooke", "hooke/stiffness", "hertz", "hertz/stiffness"])),
+        _ => return Err(bad_keyword(m, "normal model", &["hooke", "hooke/stiffness", "hertz", "hertz/stiffness", "hertz/viscoelastic"])),
     };
     while a.more() {
         let k = a.word("keyword")?;
@@ -408,8 +456,9 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                 spec.tangential = match t.text.as_str() {
                     "no_history" => TangentialSpec::LigNoHistory,
                     "history" => TangentialSpec::LigHistory,
+                    "history/paper" => TangentialSpec::PaperHistory,
                     "tan_luding" => return Err(Error::unsupported(t.span, "LIGGGHTS tangential model 'tan_luding'")),
-                    _ => return Err(bad_keyword(t, "tangential model", &["no_history", "history"])),
+                    _ => return Err(bad_keyword(t, "tangential model", &["no_history", "history", "history/paper"])),
                 };
             }
             "cohesion" => {
@@ -418,10 +467,11 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                     "off" => CohesionSpec::Off,
                     "sjkr" => CohesionSpec::Sjkr { tangential_reduce: false },
                     "sjkr2" => CohesionSpec::Sjkr2 { tangential_reduce: false },
+                    "vdw" => CohesionSpec::Vdw,
                     "easo/capillary/viscous" | "washino/capillary/viscous" => {
                         return Err(Error::unsupported(c.span, format!("cohesion model '{}'", c.text)))
                     }
-                    _ => return Err(bad_keyword(c, "cohesion model", &["off", "sjkr", "sjkr2"])),
+                    _ => return Err(bad_keyword(c, "cohesion model", &["off", "sjkr", "sjkr2", "vdw"])),
                 };
             }
             "rolling_friction" => {
@@ -432,8 +482,9 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                     "epsd" => RollingSpec::Epsd { torsion: false },
                     "epsd2" => RollingSpec::Epsd2 { torsion: false },
                     "epsd3" => RollingSpec::Epsd3 { torsion: false },
+                    "epsd/paper" => RollingSpec::PaperEpsd { torsion: false },
                     "luding" => return Err(Error::unsupported(r.span, "rolling_friction model 'luding'")),
-                    _ => return Err(bad_keyword(r, "rolling_friction model", &["off", "cdt", "epsd", "epsd2", "epsd3"])),
+                    _ => return Err(bad_keyword(r, "rolling_friction model", &["off", "cdt", "epsd", "epsd2", "epsd3", "epsd/paper"])),
                 };
             }
             "surface" => {
@@ -461,7 +512,10 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
             "torsionTorque" => {
                 let on = a.yes_no("torsionTorque")?;
                 match &mut spec.rolling {
-                    RollingSpec::Epsd { torsion } | RollingSpec::Epsd2 { torsion } | RollingSpec::Epsd3 { torsion } => *torsion = on,
+                    RollingSpec::Epsd { torsion }
+                    | RollingSpec::Epsd2 { torsion }
+                    | RollingSpec::Epsd3 { torsion }
+                    | RollingSpec::PaperEpsd { torsion } => *torsion = on,
                     _ => {}
                 }
             }
@@ -677,8 +731,17 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
             if matches!(spec.normal, NormalSpec::LigHooke { .. }) {
                 needed.push(("characteristicVelocity", m.char_vel.is_some()));
             }
-            if !matches!(spec.cohesion, CohesionSpec::Off) {
+            if matches!(spec.cohesion, CohesionSpec::Sjkr { .. } | CohesionSpec::Sjkr2 { .. }) {
                 needed.push(("cohesionEnergyDensity", m.cohesion_energy_density.is_some()));
+            }
+            let surface_energy = per_pair("surfaceEnergy")?;
+            if spec.normal == NormalSpec::PaperViscoelastic {
+                needed.push(("restitutionReferenceVelocity", scalar("restitutionReferenceVelocity").is_some()));
+            }
+            if spec.cohesion == CohesionSpec::Vdw {
+                needed.push(("surfaceEnergy", surface_energy.is_some()));
+                needed.push(("vdwMinDistance", scalar("vdwMinDistance").is_some()));
+                needed.push(("vdwCutoff", scalar("vdwCutoff").is_some()));
             }
             if !matches!(spec.rolling, RollingSpec::Off) {
                 needed.push(("coefficientRollingFriction", m.rolling_friction.is_some()));
@@ -700,7 +763,34 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                 }
             }
             let settings = LiggghtsSettings { tangential_damping: spec.tangential_damping, limit_force: spec.limit_damping, units_si: s.units == super::Units::Si && !s.soft_particles };
-            let table = liggghts_pair_params(&m, &settings, span)?;
+            let mut table = liggghts_pair_params(&m, &settings, span)?;
+            if spec.normal == NormalSpec::PaperViscoelastic {
+                let v_ref = scalar("restitutionReferenceVelocity").unwrap_or(0.0);
+                let exact = scalar("restitutionExact").unwrap_or(0.0) != 0.0;
+                for p in table.iter_mut() {
+                    p.beta = crate::physics::mixing::mp_beta(p.restitution, v_ref, exact).ok_or_else(|| {
+                        Error::deck(span, format!("hertz/viscoelastic: coefficientRestitution {} at restitutionReferenceVelocity {v_ref} gives no damping constant (need 0 < e <= 1, v > 0)", p.restitution))
+                    })?;
+                }
+            }
+            if spec.cohesion == CohesionSpec::Vdw {
+                let d_min = scalar("vdwMinDistance").unwrap_or(0.0);
+                let d_max = scalar("vdwCutoff").unwrap_or(0.0);
+                if !(d_min > 0.0) || !(d_max >= 0.0) || !d_min.is_finite() || !d_max.is_finite() {
+                    return Err(Error::deck(span, format!("cohesion vdw: vdwMinDistance {d_min} must be > 0 and vdwCutoff {d_max} >= 0")));
+                }
+                let gamma = surface_energy.unwrap_or_default();
+                for (p, &g) in table.iter_mut().zip(gamma.iter()) {
+                    if !(g >= 0.0) || !g.is_finite() {
+                        return Err(Error::deck(span, format!("cohesion vdw: surfaceEnergy {g} must be >= 0")));
+                    }
+                    p.cohesion = g;
+                    p.d_min = d_min;
+                    p.d_max = d_max;
+                    p.hamaker = crate::physics::mixing::hamaker_constant(g, d_min);
+                    p.extra_range = if g > 0.0 { d_max } else { 0.0 };
+                }
+            }
             for i in 1..=nt {
                 for j in 1..=nt {
                     *t.get_mut(i as u32, j as u32) = table[(i - 1) * nt + (j - 1)];

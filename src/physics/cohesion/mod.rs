@@ -5,3 +5,4 @@
 
 pub mod sjkr;
 pub mod sjkr2;
+pub mod vdw;

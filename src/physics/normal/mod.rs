@@ -17,6 +17,7 @@ pub mod hertz;
 pub mod hertz_stiffness;
 pub mod gran;
 pub mod granular;
+pub mod viscoelastic;
 
 use super::ContactOut;
 

@@ -14,6 +14,7 @@ pub mod epsd;
 pub mod epsd2;
 pub mod epsd3;
 pub mod sds;
+pub mod paper;
 
 use super::{Contact, ContactOut, PairParams, V3};
 use super::tangential::{get3, put3};

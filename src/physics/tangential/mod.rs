@@ -15,6 +15,7 @@ pub mod no_history;
 pub mod history;
 pub mod gran;
 pub mod granular;
+pub mod paper;
 
 use super::{Contact, ContactOut, V3};
 

@@ -1,0 +1,49 @@
+//! demx `tangential history/paper`: the paper's modified Cundall-Strack
+//! friction (Elekes & Parteli 2021, Eq. 11):
+//!
+//! F_t = -min(mu |F^c_n|, |int k_t sqrt(delta) ds + A_t sqrt(delta) v_t|) e_t
+//!
+//! The spring is the path integral of k_t sqrt(delta(t)) ds, accumulated
+//! incrementally (each step adds the normal law's current stiffness
+//! k_t sqrt(delta) times v_t dt), so it differs from LIGGGHTS `history`
+//! (current stiffness times total displacement) when delta changes during
+//! the contact. The damping A_t sqrt(delta) v_t comes from the normal law
+//! (`out.gamma_t`). The cap is on the total (spring + damping), as Eq. 11
+//! writes it; on slip the stored spring is set to the cap along the force
+//! (Cundall-Strack). The spring is kept in the tangent plane (normal part
+//! projected out each step). Relative velocity and torque use the
+//! LIGGGHTS contact-point distance R - delta/2 (the paper writes the torque
+//! lever as d/2 - delta; the difference is delta/2 << d).
+
+use super::{add_tangential_torque, get3, liggghts_levers, put3, rel_tangential_velocity};
+use crate::physics::{Contact, ContactOut, PairParams, TangentialLaw, V3};
+
+/// The paper's Cundall-Strack friction. Reads `mu`; `out.kt`, `out.gamma_t`,
+/// `out.fn_for_friction`. History: the spring force (3, N).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PaperCundallStrack;
+
+impl TangentialLaw for PaperCundallStrack {
+    const HISTORY: usize = 3;
+    #[inline]
+    fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
+        let (cri, crj) = liggghts_levers(c);
+        let v_t = rel_tangential_velocity(c, cri, crj);
+        let mut spring = get3(hist);
+        spring -= c.n * spring.dot(&c.n);
+        spring += v_t * (out.kt * c.dt);
+        let total: V3 = spring + v_t * out.gamma_t;
+        let cap = p.mu * out.fn_for_friction.abs();
+        let mag = total.norm();
+        let ft = if mag > cap {
+            let capped = total * (cap / mag);
+            spring = capped;
+            -capped
+        } else {
+            -total
+        };
+        put3(hist, &spring);
+        out.ft = ft;
+        add_tangential_torque(c, &ft, cri, crj, out);
+    }
+}
