@@ -590,3 +590,80 @@ pub fn parse_ave_time(id: &str, a: &mut Args, check: bool) -> Result<AveTime> {
     }
     Ok(AveTime { id: id.to_string(), nevery, nrepeat, nfreq, values, running, start, file, sums: vec![], count: 0, result: vec![], total: vec![], windows: 0, header_written: false })
 }
+
+/// `fix ID group check/timestep/gran N fraction_rayleigh fraction_hertz`
+/// (LIGGGHTS): every N steps the time step as a fraction of the Rayleigh time
+/// of the smallest particle and of the Hertz time at the largest particle
+/// speed; `f_ID[1]`, `f_ID[2]` are those fractions; a warning is printed above
+/// the given fractions, as LIGGGHTS does.
+pub struct CheckTimestep {
+    id: String,
+    every: i64,
+    limit: (f64, f64),
+    /// (Young's modulus, Poisson ratio) per atom type, 0-based.
+    materials: Vec<(f64, f64)>,
+    fractions: (f64, f64),
+}
+
+impl CheckTimestep {
+    /// A check fix.
+    pub fn new(id: &str, every: i64, fr: f64, fh: f64, materials: Vec<(f64, f64)>) -> CheckTimestep {
+        CheckTimestep { id: id.to_string(), every, limit: (fr, fh), materials, fractions: (0.0, 0.0) }
+    }
+    fn compute(&mut self, sim: &Sim) {
+        let p = &sim.particles;
+        let vmax = p.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let (mut fr, mut fh) = (0.0f64, 0.0f64);
+        for i in 0..p.len() {
+            let Some(&(y, nu)) = self.materials.get(p.kind[i] as usize - 1) else { continue };
+            if y <= 0.0 {
+                continue;
+            }
+            let (r, rho) = (p.radius[i], p.density[i]);
+            let g = y / (2.0 * (1.0 + nu));
+            // Rayleigh time pi R sqrt(rho/G) / (0.1631 nu + 0.8766)
+            let tr = std::f64::consts::PI * r * (rho / g).sqrt() / (0.1631 * nu + 0.8766);
+            fr = fr.max(sim.dt / tr);
+            if vmax > 0.0 {
+                // Hertz time 2.87 (m*^2 / (R* E*^2 v))^(1/5), two equal spheres
+                let m_eff = 0.5 * p.mass[i];
+                let e_eff = y / (2.0 * (1.0 - nu * nu));
+                let th = 2.87 * (m_eff * m_eff / (0.5 * r * e_eff * e_eff * vmax)).powf(0.2);
+                fh = fh.max(sim.dt / th);
+            }
+        }
+        self.fractions = (fr, fh);
+    }
+}
+
+impl Fix for CheckTimestep {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        "check/timestep/gran"
+    }
+    fn setup(&mut self, sim: &mut Sim) -> Result<()> {
+        self.compute(sim);
+        Ok(())
+    }
+    fn end_of_step(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
+        if self.every > 0 && sim.step % self.every == 0 {
+            self.compute(sim);
+            if self.fractions.0 > self.limit.0 {
+                sim.log.line(&format!("WARNING: time-step is {:.6} % of rayleigh time", 100.0 * self.fractions.0));
+            }
+            if self.fractions.1 > self.limit.1 {
+                sim.log.line(&format!("WARNING: time-step is {:.6} % of hertz time", 100.0 * self.fractions.1));
+            }
+        }
+        Ok(())
+    }
+    fn vector(&self, _sim: &Sim, i: usize) -> Option<f64> {
+        match i {
+            1 => Some(self.fractions.0),
+            2 => Some(self.fractions.1),
+            _ => None,
+        }
+    }
+}

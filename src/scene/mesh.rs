@@ -10,7 +10,7 @@
 //! `engine/mesh_surface.rs`.
 
 use super::args::{self, Args};
-use super::model::{self, CohesionSpec, NormalSpec, PairSpec, RollingSpec, TangentialSpec};
+use super::model::{self, NormalSpec, PairSpec, TangentialSpec};
 use super::Session;
 use crate::engine::fix::Fix;
 use crate::engine::kernel::{ContactKernel, ParamTable};
@@ -318,20 +318,6 @@ fn move_mesh(s: &mut Session, cmd: &Command, id: &str, a: &mut Args) -> Result<(
 
 // ---------------------------------------------------------- wall/gran mesh
 
-fn base_spec(cmd: &Command) -> PairSpec {
-    PairSpec {
-        span: cmd.span,
-        normal: NormalSpec::LigHertz,
-        tangential: TangentialSpec::LigNoHistory,
-        cohesion: CohesionSpec::Off,
-        rolling: RollingSpec::Off,
-        tangential_damping: true,
-        limit_damping: false,
-        gran: None,
-        granular: vec![],
-        has_coeff: true,
-    }
-}
 
 struct WallMesh {
     mesh: SharedMesh,
@@ -432,7 +418,7 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
     s.set_dialect(Dialect::Liggghts);
     let words = a.rest().to_vec();
     let end = words.iter().position(|w| w.text == "mesh").ok_or_else(|| Error::deck(a.end_span(), "fix wall/gran: missing `mesh n_meshes N meshes ...`"))?;
-    let mut spec = base_spec(cmd);
+    let mut spec = PairSpec::new(cmd.span, true);
     if end > 0 {
         let model_cmd = Command { words: std::iter::once(cmd.words[0].clone()).chain(words[..end].iter().cloned()).collect(), span: cmd.span };
         let mut ma = Args::new(&model_cmd);
@@ -633,7 +619,7 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
     s.need_box(cmd)?;
     s.set_dialect(Dialect::Lammps);
     let first = a.word("wall style")?;
-    let mut spec = base_spec(cmd);
+    let mut spec = PairSpec::new(cmd.span, true);
     match first.text.as_str() {
         "hooke" | "hooke/history" | "hertz/history" => {
             let kn = a.f64("Kn")?;

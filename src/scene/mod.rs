@@ -300,7 +300,12 @@ impl Session {
         if !self.sim.fixes.iter().any(|f| f.integrates()) && !self.check {
             self.sim.log.line("WARNING: No fixes defined, atoms won't move");
         }
-        self.sim.run(steps, vars, pre || self.schedule.len() == 1, post)
+        let r = self.sim.run(steps, vars, pre || self.schedule.len() == 1, post);
+        match r {
+            // in check mode a run-time failure is a fault of the deck: say where
+            Err(Error::Runtime { msg }) if self.check => Err(Error::deck(cmd.words[0].span, format!("this run would fail: {msg}"))),
+            other => other,
+        }
     }
 }
 

@@ -143,6 +143,24 @@ pub struct PairSpec {
 }
 
 impl PairSpec {
+    /// The defaults of a model block (LIGGGHTS: hertz, no tangential history,
+    /// no cohesion or rolling, tangential damping on); walls pass
+    /// `has_coeff = true` since they need no `pair_coeff`.
+    pub fn new(span: Span, has_coeff: bool) -> PairSpec {
+        PairSpec {
+            span,
+            normal: NormalSpec::LigHertz,
+            tangential: TangentialSpec::LigNoHistory,
+            cohesion: CohesionSpec::Off,
+            rolling: RollingSpec::Off,
+            tangential_damping: true,
+            limit_damping: false,
+            gran: None,
+            granular: vec![],
+            has_coeff,
+        }
+    }
+
     /// Model keywords of this spec that only demx knows (the paper's laws).
     pub fn demx_extensions(&self) -> Vec<&'static str> {
         let mut v = vec![];
@@ -331,18 +349,7 @@ pub fn execute(s: &mut Session, cmd: &Command) -> Result<()> {
         return Ok(());
     }
     let style = a.word("pair style")?;
-    let mut spec = PairSpec {
-        span: cmd.span,
-        normal: NormalSpec::LigHertz,
-        tangential: TangentialSpec::LigNoHistory,
-        cohesion: CohesionSpec::Off,
-        rolling: RollingSpec::Off,
-        tangential_damping: true,
-        limit_damping: false,
-        gran: None,
-        granular: vec![],
-        has_coeff: false,
-    };
+    let mut spec = PairSpec::new(cmd.span, false);
     match style.text.as_str() {
         "none" => {
             s.pair = None;
@@ -855,7 +862,22 @@ pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: 
             s.sim.particles.add_extra(&name.text, vals);
             Ok(())
         }
-        "check/timestep/gran" | "enforce2d" | "momentum" => {
+        "check/timestep/gran" => {
+            let every = a.i64("N")?;
+            let fr = a.f64("fraction_rayleigh")?;
+            let fh = a.f64("fraction_hertz")?;
+            while a.more() {
+                a.word("keyword")?;
+            }
+            let materials = (1..=s.sim.ntypes.max(1))
+                .map(|t| {
+                    let get = |n: &str| s.props.get(n).and_then(|(_, v)| v.get(t - 1).copied());
+                    (get("youngsModulus").unwrap_or(0.0), get("poissonsRatio").unwrap_or(0.0))
+                })
+                .collect();
+            s.add_fix(Box::new(super::fixes::CheckTimestep::new(id, every, fr, fh, materials)))
+        }
+        "enforce2d" | "momentum" => {
             s.notes.push((cmd.span, format!("fix {}: accepted; demx reports timestep criteria in `demx check`", style.text)));
             Ok(())
         }

@@ -4,7 +4,7 @@
 //! in a per-atom column so it follows particles through reordering.
 
 use super::args::Args;
-use super::model::{self, CohesionSpec, NormalSpec, PairSpec, RollingSpec, TangentialSpec};
+use super::model::{self, NormalSpec, PairSpec, TangentialSpec};
 use super::Session;
 use crate::engine::fix::Fix;
 use crate::engine::kernel::{ContactKernel, ParamTable};
@@ -106,7 +106,7 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
     let (spec, table, wall_type, wall, motion) = if first.text == "model" {
         s.set_dialect(Dialect::Liggghts);
         a.pos -= 1;
-        let mut spec = base_spec(cmd);
+        let mut spec = PairSpec::new(cmd.span, true);
         // the model block ends at `primitive` or `mesh`
         let words = rest_after(a);
         let end = words.iter().position(|w| w.text == "primitive" || w.text == "mesh").ok_or_else(|| {
@@ -145,7 +145,7 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
         (spec, table, wt as u32, wall, WallMotion::None)
     } else {
         s.set_dialect(Dialect::Lammps);
-        let mut spec = base_spec(cmd);
+        let mut spec = PairSpec::new(cmd.span, true);
         // 2012-era LAMMPS: `fix wall/gran Kn Kt gn gt xmu dampflag wallstyle ...`
         // takes its force style from the pair style.
         let legacy = super::args::parse_f64(first).is_ok();
@@ -224,17 +224,3 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
     }))
 }
 
-fn base_spec(cmd: &Command) -> PairSpec {
-    PairSpec {
-        span: cmd.span,
-        normal: NormalSpec::LigHertz,
-        tangential: TangentialSpec::LigNoHistory,
-        cohesion: CohesionSpec::Off,
-        rolling: RollingSpec::Off,
-        tangential_damping: true,
-        limit_damping: false,
-        gran: None,
-        granular: vec![],
-        has_coeff: true,
-    }
-}
