@@ -184,11 +184,17 @@ pub fn main() -> ExitCode {
     match cli.cmd {
         Cmd::Run { mut deck, threads, log, quiet, max_steps } => {
             deck.var_groups = groups.clone();
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build_global();
-            if pool.is_err() {
-                eprintln!("warning: thread pool already initialised");
-            }
-            let (_s, sources, r) = run_deck(&deck, false, threads, Some(&log), quiet, max_steps);
+            // the whole run executes on a pool thread: parallel passes then
+            // run inline (one thread) or fork from a worker, without waking
+            // the pool from outside every step
+            let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build() {
+                Ok(p) => p,
+                Err(e) => {
+                    eprintln!("error: cannot start {threads} threads: {e}");
+                    return ExitCode::from(1);
+                }
+            };
+            let (_s, sources, r) = pool.install(|| run_deck(&deck, false, threads, Some(&log), quiet, max_steps));
             match r {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => report(&e, &sources),
