@@ -64,37 +64,11 @@ pub fn packing(f: &Frame) -> Result<Packing> {
     Ok(Packing { phi, phi_mean: mean, sd, sub, z_max, counted, diameter })
 }
 
-#[derive(clap::Parser, Debug)]
-#[command(name = "demx packing", about = "Packing fraction of a settled column (Elekes & Parteli 2021)")]
-struct Cli {
-    /// Dump with x y z (or xs ys zs) and radius (or diameter).
-    dump: String,
-    /// Frame index (0-based; negative from the end; default: the last).
-    #[arg(long, allow_hyphen_values = true)]
-    frame: Option<i64>,
-    /// Print JSON.
-    #[arg(long)]
-    json: bool,
-    /// Surface energy gamma (J/m^2) for the Bond number.
-    #[arg(long, default_value_t = 0.05)]
-    gamma: f64,
-    /// Gravity (m/s^2) for the Bond number.
-    #[arg(long, default_value_t = 9.81)]
-    g: f64,
-    /// Particle density (kg/m^3) for the Bond number.
-    #[arg(long, default_value_t = 2500.0)]
-    rho: f64,
-}
-
 /// Entry point: `args` are the words after the subcommand name.
 pub fn cli(args: Vec<String>) -> ExitCode {
-    use clap::Parser;
-    let c = match Cli::try_parse_from(std::iter::once("demx packing".to_string()).chain(args)) {
+    let c = match super::repose::HeapCli::parse("demx packing", "Packing fraction of a settled column (Elekes & Parteli 2021)", args) {
         Ok(c) => c,
-        Err(e) => {
-            let _ = e.print();
-            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
-        }
+        Err(code) => return code,
     };
     match pick_frame(&c.dump, c.frame).and_then(|f| packing(&f)) {
         Ok(p) => {

@@ -161,37 +161,48 @@ pub(crate) fn pick_frame(path: &str, index: Option<i64>) -> Result<Frame> {
     Ok(frames.swap_remove(i as usize))
 }
 
+/// Arguments shared by `demx repose` and `demx packing`.
 #[derive(clap::Parser, Debug)]
-#[command(name = "demx repose", about = "Angle of repose of a heap (Elekes & Parteli 2021)")]
-struct Cli {
+pub struct HeapCli {
     /// LIGGGHTS/LAMMPS dump with x y z (or xs ys zs) and radius (or diameter).
-    dump: String,
+    pub dump: String,
     /// Frame index (0-based; negative from the end; default: the last).
     #[arg(long, allow_hyphen_values = true)]
-    frame: Option<i64>,
+    pub frame: Option<i64>,
     /// Print JSON.
     #[arg(long)]
-    json: bool,
+    pub json: bool,
     /// Surface energy gamma (J/m^2) for the Bond number.
     #[arg(long, default_value_t = 0.05)]
-    gamma: f64,
+    pub gamma: f64,
     /// Gravity (m/s^2) for the Bond number.
     #[arg(long, default_value_t = 9.81)]
-    g: f64,
+    pub g: f64,
     /// Particle density (kg/m^3) for the Bond number.
     #[arg(long, default_value_t = 2500.0)]
-    rho: f64,
+    pub rho: f64,
+}
+
+impl HeapCli {
+    /// Parse the words after `name`; `Err` carries the exit code (help: 0, bad use: 2).
+    pub fn parse(name: &'static str, about: &'static str, args: Vec<String>) -> std::result::Result<HeapCli, ExitCode> {
+        use clap::{CommandFactory, FromArgMatches};
+        let cmd = HeapCli::command().name(name).about(about);
+        match cmd.try_get_matches_from(std::iter::once(name.to_string()).chain(args)).and_then(|m| HeapCli::from_arg_matches(&m)) {
+            Ok(c) => Ok(c),
+            Err(e) => {
+                let _ = e.print();
+                Err(ExitCode::from(if e.use_stderr() { 2 } else { 0 }))
+            }
+        }
+    }
 }
 
 /// Entry point: `args` are the words after the subcommand name.
 pub fn cli(args: Vec<String>) -> ExitCode {
-    use clap::Parser;
-    let c = match Cli::try_parse_from(std::iter::once("demx repose".to_string()).chain(args)) {
+    let c = match HeapCli::parse("demx repose", "Angle of repose of a heap (Elekes & Parteli 2021)", args) {
         Ok(c) => c,
-        Err(e) => {
-            let _ = e.print();
-            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
-        }
+        Err(code) => return code,
     };
     let res = pick_frame(&c.dump, c.frame).and_then(|f| repose(&f));
     match res {

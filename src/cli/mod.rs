@@ -68,18 +68,25 @@ enum Cmd {
         what: DumpCmd,
     },
     /// Compare runs: dumps, output folders, or a deck against an engine.
+    #[command(disable_help_flag = true)]
     Compare(Passthrough),
     /// Run the real LIGGGHTS/LAMMPS on a deck and collect full-precision results.
+    #[command(disable_help_flag = true)]
     Reference(Passthrough),
     /// Convert legacy decks and translate between LIGGGHTS and LAMMPS.
+    #[command(disable_help_flag = true)]
     Convert(Passthrough),
     /// Angle of repose of a heap, the paper's way.
+    #[command(disable_help_flag = true)]
     Repose(Passthrough),
     /// Packing fraction of a settled column, the paper's way.
+    #[command(disable_help_flag = true)]
     Packing(Passthrough),
     /// Aeolian transport measurements over a run's outputs.
+    #[command(disable_help_flag = true)]
     Saltation(Passthrough),
     /// What accuracy costs in time: run a deck over settings.
+    #[command(disable_help_flag = true)]
     Tradeoff(Passthrough),
 }
 
