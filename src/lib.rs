@@ -18,5 +18,6 @@ pub mod io;
 pub mod analysis;
 pub mod convert;
 pub mod cli;
+pub mod plot;
 
 pub use error::{Error, Result};

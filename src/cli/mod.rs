@@ -178,7 +178,11 @@ fn report(err: &Error, sources: &SourceMap) -> ExitCode {
 
 /// Entry point.
 pub fn main() -> ExitCode {
-    let (args, groups) = extract_vars(std::env::args().collect());
+    let raw: Vec<String> = std::env::args().collect();
+    // only run and check take -var themselves; the other subcommands parse
+    // their own (compare, reference and tradeoff pass them on to runs)
+    let own_vars = matches!(raw.get(1).map(String::as_str), Some("run" | "check"));
+    let (args, groups) = if own_vars { extract_vars(raw) } else { (raw, vec![]) };
     let args = normalise_args(args);
     let cli = match Cli::try_parse_from(args) {
         Ok(c) => c,
