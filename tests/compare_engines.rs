@@ -69,17 +69,20 @@ fn settle_lammps_reports_divergence() {
 }
 
 /// Same for LIGGGHTS (its stored reference leaves 1e-6 no earlier than step
-/// 1500). The verdict is not asserted: after divergence the centre of mass of
-/// the bouncing column differs by ~0.07 d, beyond the fixed 0.05 d default,
-/// and the deck has no seed to measure the natural spread with. The particle
-/// count and the KE curve (within 3 % of the peak, the engine issue's ke_rel)
-/// must agree.
+/// 1500). After divergence the centre of mass of the bouncing column differs
+/// by ~0.07 d, beyond the fixed 0.05 d floor: the verdict comes from the
+/// spread of a 3-member demx ensemble (the deck's own initial state, moved by
+/// 1e-6 radii), which says how far two equally valid runs end up.
 #[test]
-fn settle_liggghts_reports_divergence() {
+fn settle_liggghts_passes_against_the_ensemble_spread() {
     if let Some((code, out)) = against("settle/in.settle.liggghts", "liggghts") {
-        assert!(code == 0 || code == 1, "{out}");
+        assert_eq!(code, 0, "{out}");
         assert!(out.contains("divergence: first frame beyond tolerance at timestep "), "{out}");
-        assert!(!out.contains("particle count differs") && !out.contains("kinetic energy differs"), "{out}");
+        assert!(out.contains("3-member demx ensemble"), "{out}");
+        for stat in ["count", "KE/peak", "coordination", "com x", "com y", "com z"] {
+            let line = out.lines().find(|l| l.trim_start().starts_with(stat) && l.contains(" 8000 ")).unwrap_or_else(|| panic!("{stat}: {out}"));
+            assert!(line.ends_with("ok"), "{line}");
+        }
     }
 }
 

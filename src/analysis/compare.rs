@@ -806,6 +806,25 @@ pub struct CompareArgs {
     /// Write every frame's numbers to this CSV file.
     #[arg(long)]
     pub csv: Option<PathBuf>,
+    /// With --against: the scene is a heap; judge its final angle of repose
+    /// and core packing fraction (`demx repose`) across seeds too.
+    #[arg(long)]
+    pub heap: bool,
+    /// Allowed θr difference beyond the seeds' spread (degrees).
+    #[arg(long, default_value_t = 0.5)]
+    pub tol_theta: f64,
+    /// Allowed core packing-fraction difference beyond the seeds' spread.
+    #[arg(long, default_value_t = 0.01)]
+    pub tol_phi: f64,
+    /// With --against and one seed: when the trajectories diverge (chaos),
+    /// run this many extra demx ensemble members, each started with every
+    /// particle moved by --perturb of its radius, and judge the statistics
+    /// against the ensemble's spread (0: fixed tolerances only).
+    #[arg(long, default_value_t = 2)]
+    pub ensemble: usize,
+    /// Perturbation of the ensemble members, in particle radii.
+    #[arg(long, default_value_t = 1e-6)]
+    pub perturb: f64,
     /// Variables for --against runs (filled from `-var NAME VALUE...`).
     #[arg(skip)]
     pub vars: Vec<(String, Vec<String>)>,
@@ -866,7 +885,26 @@ fn run(args: &CompareArgs) -> Result<ExitCode> {
         return Err(Error::usage("demx compare needs two runs A B, or a deck with --against liggghts|lammps"));
     };
     let cs = compare_inputs(&args.a, b, &args.options())?;
-    report(args, &cs, None)
+    if !args.heap {
+        return report(args, &cs, None);
+    }
+    // heaps: the final frames' angle of repose and core packing, judged
+    // against the fixed tolerances (one run each: no spread to use)
+    let last = |spec: &str| -> Result<Option<super::compare_stats::HeapStats>> {
+        Ok(load(spec)?.first().and_then(|s| s.snaps.last()).and_then(super::compare_stats::heap_stats))
+    };
+    let (ha, hb) = (last(&args.a)?, last(b)?);
+    let heap_ok = match (ha, hb) {
+        (Some(x), Some(y)) => (x.theta - y.theta).abs() <= args.tol_theta && (x.phi - y.phi).abs() <= args.tol_phi,
+        _ => false,
+    };
+    let code = report(args, &cs, Some(serde_json::json!({ "heap": [ha, hb], "heap_pass": heap_ok })))?;
+    if !args.json {
+        let f = |h: &Option<super::compare_stats::HeapStats>| h.map_or("no heap".to_string(), |h| format!("theta_r {:.2} +- {:.2} deg, phi {:.3}, {} particles", h.theta, h.theta_sd, h.phi, h.count));
+        println!("heap A: {}\nheap B: {}", f(&ha), f(&hb));
+        println!("heap verdict (theta_r within {} deg, phi within {}): {}", args.tol_theta, args.tol_phi, if heap_ok { "PASS" } else { "FAIL" });
+    }
+    Ok(if heap_ok { code } else { ExitCode::from(1) })
 }
 
 /// Entry point: `args` are the words after the subcommand name.

@@ -209,3 +209,94 @@ mod tests {
         assert!((kolmogorov_q(1.628) - 0.01).abs() < 1e-3);
     }
 }
+
+/// Heap statistics of a frame: the angle of repose the paper's way
+/// (`demx repose`) and the packing fraction of the heap's core.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct HeapStats {
+    /// Particles in the frame.
+    pub count: usize,
+    /// Angle of repose, mean of the x-z and y-z projections (degrees).
+    pub theta: f64,
+    /// Half the difference of the two projections' angles times sqrt 2 (degrees).
+    pub theta_sd: f64,
+    /// Solid fraction in the core cylinder (see [`heap_stats`]).
+    pub phi: f64,
+}
+
+/// θr and core packing fraction of a heap resting on a plate (the plate is
+/// the lowest sphere bottom). The core is a vertical cylinder on the heap's
+/// axis (the particles' mean x, y) of radius a quarter of the base radius
+/// h/tan θr, from one mean diameter above the plate (skipping the layering
+/// at the plate) to half the heap height h; the cylinder then lies wholly
+/// under the conical surface. Its solid fraction is counted on a grid of
+/// points d/10 apart. None when the frame has no radii or no heap shape.
+pub fn heap_stats(s: &Snap) -> Option<HeapStats> {
+    let r = s.r.as_ref()?;
+    let n = r.len();
+    if n == 0 {
+        return None;
+    }
+    let plate = (0..n).map(|i| s.x[i][2] - r[i]).fold(f64::INFINITY, f64::min);
+    let zh: Vec<f64> = (0..n).map(|i| s.x[i][2] - plate).collect();
+    let xs: Vec<f64> = s.x.iter().map(|p| p[0]).collect();
+    let ys: Vec<f64> = s.x.iter().map(|p| p[1]).collect();
+    let rmin = r.iter().cloned().fold(f64::INFINITY, f64::min);
+    let txz = super::repose::projection_angle(&xs, &zh, r, rmin / 5.0)?;
+    let tyz = super::repose::projection_angle(&ys, &zh, r, rmin / 5.0)?;
+    let theta = 0.5 * (txz + tyz);
+    let h = (0..n).map(|i| zh[i] + r[i]).fold(0.0, f64::max);
+    let d = 2.0 * r.iter().sum::<f64>() / n as f64;
+    let (cx, cy) = (xs.iter().sum::<f64>() / n as f64, ys.iter().sum::<f64>() / n as f64);
+    let rc = 0.25 * h / theta.to_radians().tan().max(1e-6);
+    let (z0, z1) = (d, 0.5 * h);
+    let mut phi = 0.0;
+    if z1 > z0 && rc > 0.0 {
+        // bin the spheres near the core by (x, y) cells of size 2 rmax
+        let rmax = r.iter().cloned().fold(0.0, f64::max);
+        let cell = 2.0 * rmax;
+        let m = ((2.0 * (rc + cell)) / cell).ceil() as usize + 1;
+        let (ox, oy) = (cx - rc - cell, cy - rc - cell);
+        let mut bins: Vec<Vec<usize>> = vec![vec![]; m * m];
+        for i in 0..n {
+            let (bx, by) = (((xs[i] - ox) / cell).floor(), ((ys[i] - oy) / cell).floor());
+            if bx >= 0.0 && by >= 0.0 && (bx as usize) < m && (by as usize) < m {
+                bins[by as usize * m + bx as usize].push(i);
+            }
+        }
+        let step = d / 10.0;
+        let (mut inside, mut total) = (0usize, 0usize);
+        let k = (rc / step).ceil() as i64;
+        let kz = ((z1 - z0) / step).ceil() as i64;
+        for a in -k..=k {
+            for b in -k..=k {
+                let (px, py) = (cx + a as f64 * step, cy + b as f64 * step);
+                if (px - cx).powi(2) + (py - cy).powi(2) > rc * rc {
+                    continue;
+                }
+                let (bx, by) = (((px - ox) / cell).floor() as i64, ((py - oy) / cell).floor() as i64);
+                for c in 0..kz {
+                    let pz = plate + z0 + (c as f64 + 0.5) * step;
+                    total += 1;
+                    let hit = (bx - 1..=bx + 1).any(|u| {
+                        (by - 1..=by + 1).any(|v| {
+                            u >= 0
+                                && v >= 0
+                                && (u as usize) < m
+                                && (v as usize) < m
+                                && bins[v as usize * m + u as usize].iter().any(|&i| {
+                                    let q = s.x[i];
+                                    (q[0] - px).powi(2) + (q[1] - py).powi(2) + (q[2] - pz).powi(2) < r[i] * r[i]
+                                })
+                        })
+                    });
+                    inside += hit as usize;
+                }
+            }
+        }
+        if total > 0 {
+            phi = inside as f64 / total as f64;
+        }
+    }
+    Some(HeapStats { count: n, theta, theta_sd: (txz - tyz).abs() / std::f64::consts::SQRT_2, phi })
+}

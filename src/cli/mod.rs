@@ -25,6 +25,11 @@ pub struct DeckArgs {
     /// `-var NAME VALUE ...` (also `-v`), as LAMMPS takes them; may repeat.
     #[arg(long = "var", short = 'v', num_args = 2.., value_names = ["NAME", "VALUE"], allow_hyphen_values = true)]
     pub var: Vec<String>,
+    /// Ensemble member of a chaotic scene: before the first run, move every
+    /// particle by AMP of its radius in a direction drawn from SEED and its id
+    /// (`SEED:AMP`, e.g. `1:1e-6`).
+    #[arg(long, value_name = "SEED:AMP", value_parser = parse_perturb)]
+    pub perturb: Option<(u64, f64)>,
     /// Grouped `-var` values (filled from the raw arguments).
     #[arg(skip)]
     pub var_groups: Vec<Vec<String>>,
@@ -107,6 +112,16 @@ enum DumpCmd {
     },
 }
 
+fn parse_perturb(s: &str) -> std::result::Result<(u64, f64), String> {
+    let (a, b) = s.split_once(':').ok_or("expected SEED:AMP, e.g. 1:1e-6")?;
+    let seed = a.parse::<u64>().map_err(|e| format!("seed '{a}': {e}"))?;
+    let amp = b.parse::<f64>().map_err(|e| format!("amplitude '{b}': {e}"))?;
+    if !amp.is_finite() || amp < 0.0 {
+        return Err(format!("amplitude '{b}' must be a finite number >= 0"));
+    }
+    Ok((seed, amp))
+}
+
 fn cli_vars(d: &DeckArgs) -> Vec<(String, Vec<String>)> {
     d.var_groups.iter().filter(|v| !v.is_empty()).map(|v| (v[0].clone(), v[1..].to_vec())).collect()
 }
@@ -155,6 +170,7 @@ pub fn run_deck(deck: &DeckArgs, check: bool, threads: usize, log: Option<&str>,
     let mut session = Session::new(check);
     session.threads = threads;
     session.max_steps = max_steps;
+    session.perturb = deck.perturb;
     if check || quiet {
         session.sim.log.screen = false;
     }

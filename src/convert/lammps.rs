@@ -147,7 +147,16 @@ fn granular_coeffs(ctx: &mut Ctx, m: &Model3, i: usize, j: usize) -> Option<Stri
                     format!("mindlin {} {} {}", fmt(8.0 * p.g_star), fmt(xgt), fmt(p.mu))
                 }
             };
-            Some(format!("hertz/material {} {} {} tangential {tang} damping tsuji", fmt(e_lmp), fmt(e_p), fmt(p.nu)))
+            let roll = match rolling_sds(ctx, m, &p, i, j) {
+                Some(r) => format!(" {r}"),
+                None => {
+                    if let Some(r) = m.rolling.as_deref().filter(|r| r.starts_with("epsd")) {
+                        ctx.note(Severity::Approx, format!("rolling_friction {r}: no constant radius, density or coefficientRollingFriction for types {i} {j}, so no rolling sds equivalent: dropped"));
+                    }
+                    String::new()
+                }
+            };
+            Some(format!("hertz/material {} {} {} tangential {tang} damping tsuji{roll}", fmt(e_lmp), fmt(e_p), fmt(p.nu)))
         }
         "hooke/stiffness" | "hertz/stiffness" => {
             let kn = f.pair_value("kn", i, j)?;
@@ -162,6 +171,66 @@ fn granular_coeffs(ctx: &mut Ctx, m: &Model3, i: usize, j: usize) -> Option<Stri
         }
         _ => None,
     }
+}
+
+/// Radius and density of the particles of type `t`, from a particle template.
+fn type_particle(f: &Facts, t: usize) -> Option<(f64, f64)> {
+    let mut found = None;
+    for tp in f.templates.values() {
+        if f.num(&tp.atom_type).map(|v| v as usize) == Some(t) {
+            let (r, rho) = (f.num(&tp.radius)?, f.num(&tp.density)?);
+            if found.is_some_and(|(r0, _)| r0 != r) {
+                return None; // several sizes of one type: no single radius
+            }
+            found = Some((r, rho));
+        }
+    }
+    found
+}
+
+/// Rolling models LIGGGHTS EPSD-family -> LAMMPS `rolling sds k_roll 0 mu_roll`.
+/// Both cap the rolling torque at mu_r R* |F_n| (LIGGGHTS rolling_model_epsd*.h;
+/// LAMMPS pair_granular: torque R_eff n x F_roll with |F_roll| <= mu_roll F_n),
+/// so mu_roll = mu_r is exact. The spring is not: EPSD's k_r follows the
+/// contact (epsd: 2.25 k_n mu_r^2 R*^2, epsd2: k_t R*^2 with the Hertz
+/// stiffnesses at the current overlap), SDS's k_roll R*^2 is constant. k_roll
+/// is taken at a reference overlap: the Hertz overlap under ten particle
+/// weights (a contact a few layers deep in a resting pile) when gravity is
+/// known, else 0.1% of R*.
+fn rolling_sds(ctx: &mut Ctx, m: &Model3, p: &Pair, i: usize, j: usize) -> Option<String> {
+    let r = m.rolling.as_deref()?;
+    if !matches!(r, "epsd" | "epsd2" | "epsd3") {
+        return None;
+    }
+    let f = ctx.facts;
+    let mu_r = f.pair_value("coefficientRollingFriction", i, j)?;
+    let ((ri, rhoi), (rj, _)) = (type_particle(f, i)?, type_particle(f, j)?);
+    let r_star = ri * rj / (ri + rj);
+    let delta = match f.gravity {
+        Some(g) if g > 0.0 => {
+            let weight = 10.0 * rhoi * 4.0 / 3.0 * std::f64::consts::PI * ri.powi(3) * g;
+            // Hertz: F = 4/3 Y* sqrt(R*) delta^(3/2)
+            (3.0 * weight / (4.0 * p.y_star * r_star.sqrt())).powf(2.0 / 3.0)
+        }
+        _ => 1e-3 * r_star,
+    };
+    let a = (r_star * delta).sqrt();
+    let (kn, kt) = (2.0 * p.y_star * a, 8.0 * p.g_star * a);
+    let k_roll = match r {
+        "epsd" => 2.25 * kn * mu_r * mu_r,
+        "epsd2" => kt,
+        _ => f.props.get("coeffRollingStiffness").and_then(|pr| pr.values.first()).and_then(|v| f.num(v)).map(|c| c * kn * mu_r * mu_r)?,
+    };
+    ctx.note(
+        Severity::Approx,
+        format!(
+            "rolling_friction {r} -> rolling sds: the torque cap mu_r R* |Fn| is the same; the spring is constant in LAMMPS (k_roll {} N/m, LIGGGHTS' value at overlap {:.3e} m){}",
+            fmt(k_roll),
+            delta,
+            if r == "epsd" { "; the EPSD viscous rolling damping is dropped" } else { "" }
+        ),
+    );
+    Some(format!("rolling sds {} 0 {}", fmt(k_roll), fmt(mu_r)))
 }
 
 fn ntypes(ctx: &Ctx) -> usize {
@@ -198,7 +267,8 @@ fn drop_model_axes(ctx: &mut Ctx, m: &Model3) {
     if let Some(c) = &m.cohesion {
         ctx.note(Severity::Approx, format!("cohesion {c} has no LAMMPS counterpart (dmt/jkr are different laws): dropped"));
     }
-    if let Some(r) = &m.rolling {
+    let sds = m.normal == "hertz" && matches!(m.rolling.as_deref(), Some("epsd" | "epsd2" | "epsd3"));
+    if let Some(r) = m.rolling.as_ref().filter(|_| !sds) {
         ctx.note(Severity::Approx, format!("rolling_friction {r} has no LAMMPS counterpart (rolling sds is a different law): dropped"));
     }
 }

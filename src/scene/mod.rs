@@ -80,6 +80,10 @@ pub struct Session {
     pub threads: usize,
     /// Cap on the steps of every `run` command (`demx run --max-steps`).
     pub max_steps: Option<i64>,
+    /// `demx run --perturb SEED:AMP`: before the first run, move every
+    /// particle by AMP of its radius in a direction drawn from SEED and its
+    /// id (an ensemble member of a chaotic scene; `demx compare` uses it).
+    pub perturb: Option<(u64, f64)>,
     /// Wall descriptions for the summary.
     pub walls: Vec<String>,
     /// Particle sources for the summary.
@@ -164,6 +168,7 @@ impl Session {
             check,
             threads: 1,
             max_steps: None,
+            perturb: None,
             walls: vec![],
             sources: vec![],
             replay: vec![],
@@ -295,6 +300,9 @@ impl Session {
         }
         self.need_box(cmd)?;
         model::finalize(self, cmd)?;
+        if let Some((seed, amp)) = self.perturb.take().filter(|_| !self.check) {
+            perturb_positions(&mut self.sim.particles, seed, amp);
+        }
         self.schedule.push(RunRecord { steps, start: self.sim.step, particles: self.sim.particles.len() });
         self.sim.run_bounds = Some((start.unwrap_or(self.sim.step), stop.unwrap_or(self.sim.step + steps)));
         if !self.sim.fixes.iter().any(|f| f.integrates()) && !self.check {
@@ -305,6 +313,31 @@ impl Session {
             // in check mode a run-time failure is a fault of the deck: say where
             Err(Error::Runtime { msg }) if self.check => Err(Error::deck(cmd.words[0].span, format!("this run would fail: {msg}"))),
             other => other,
+        }
+    }
+}
+
+/// Displace each particle by `amp` x its radius along a unit direction that
+/// depends only on `seed` and the particle's id (not on order or threads).
+fn perturb_positions(p: &mut crate::engine::particles::Particles, seed: u64, amp: f64) {
+    // splitmix64: a well-mixed 64-bit hash of (seed, id)
+    fn mix(mut z: u64) -> u64 {
+        z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    let unit = |h: u64| (h >> 11) as f64 / (1u64 << 53) as f64;
+    for i in 0..p.len() {
+        let h1 = mix(seed ^ mix(p.tag[i] as u64));
+        let h2 = mix(h1);
+        // uniform direction on the sphere (Archimedes: z uniform in [-1, 1])
+        let z = 2.0 * unit(h1) - 1.0;
+        let phi = 2.0 * std::f64::consts::PI * unit(h2);
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        let d = [s * phi.cos(), s * phi.sin(), z];
+        for k in 0..3 {
+            p.x[i][k] += amp * p.radius[i] * d[k];
         }
     }
 }
