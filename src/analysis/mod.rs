@@ -1,5 +1,6 @@
 //! Measurements on runs: comparison with the reference engines, angle of
-//! repose, packing fraction, aeolian transport, cost-accuracy trade-offs.
+//! repose, packing fraction, aeolian transport, cost-accuracy trade-offs,
+//! size-gravity sweeps of the angle of repose.
 pub mod compare;
 pub mod compare_deck;
 pub mod compare_stats;
@@ -7,4 +8,5 @@ pub mod reference;
 pub mod repose;
 pub mod packing;
 pub mod saltation;
+pub mod sweep;
 pub mod tradeoff;

@@ -93,6 +93,9 @@ enum Cmd {
     /// What accuracy costs in time: run a deck over settings.
     #[command(disable_help_flag = true)]
     Tradeoff(Passthrough),
+    /// Angle of repose over particle size and gravity: runs and the paper's fits.
+    #[command(disable_help_flag = true)]
+    Sweep(Passthrough),
 }
 
 /// Arguments handed unparsed to a subcommand's own parser.
@@ -275,6 +278,7 @@ pub fn main() -> ExitCode {
         Cmd::Packing(p) => crate::analysis::packing::cli(p.args),
         Cmd::Saltation(p) => crate::analysis::saltation::cli(p.args),
         Cmd::Tradeoff(p) => crate::analysis::tradeoff::cli(p.args),
+        Cmd::Sweep(p) => crate::analysis::sweep::cli(p.args),
     }
 }
 

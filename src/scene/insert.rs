@@ -1167,13 +1167,11 @@ impl LiggghtsInsert {
             .zip(&self.dist.weights)
             .map(|(t, w)| format!("{} (type {}, r {}, rho {}, {:.1}% by number)", t.id, t.kind, t.radius, t.density, 100.0 * w))
             .collect();
-        format!(
-            "fix {} {}: {what}, from step {} {every}; {}",
-            self.style,
-            self.id,
-            self.next.unwrap_or(0),
-            tpl.join(", ")
-        )
+        let when = match self.next {
+            Some(n) => format!("from step {n} {every}"),
+            None => format!("{every}, no insertion left"),
+        };
+        format!("fix {} {}: {what}, {when}; {}", self.style, self.id, tpl.join(", "))
     }
 
     fn volume(&mut self, domain: &Domain) -> Result<f64> {
@@ -1259,7 +1257,7 @@ impl LiggghtsInsert {
                 InsertMode::Rate { ninsert: Some(t), .. } => self.ninserted < t,
                 _ => true,
             };
-            self.next = if more { self.next.map(|s| s + self.insert_every) } else { None };
+            self.schedule_next(more);
             return Ok(());
         }
         let maxtry = want as i64 * self.maxattempt;
@@ -1358,8 +1356,15 @@ impl LiggghtsInsert {
             InsertMode::Rate { ninsert: Some(t), .. } => self.ninserted < t,
             _ => true,
         };
-        self.next = if more { self.next.map(|s| s + self.insert_every) } else { None };
+        self.schedule_next(more);
         Ok(())
+    }
+
+    /// After an insertion event at `self.next`: the following event, or none
+    /// when `insert_every once` (LIGGGHTS inserts once, and later runs keep
+    /// the fix without inserting again) or when the target count is reached.
+    fn schedule_next(&mut self, more: bool) {
+        self.next = if self.insert_every > 0 && more { self.next.map(|s| s + self.insert_every) } else { None };
     }
 
     /// Number to insert now and the insertion ratio (pack) (LIGGGHTS `calc_ninsert_this`).
@@ -1407,7 +1412,16 @@ impl Fix for LiggghtsInsert {
     }
     fn setup(&mut self, sim: &mut Sim) -> Result<()> {
         if let Some(n) = self.next {
-            if n < sim.step {
+            if n < sim.step && sim.dry {
+                // check mode skips the steps of a run without inserting: catch
+                // the schedule up as the skipped insertions would have
+                self.next = if self.insert_every > 0 {
+                    let late = sim.step - n;
+                    Some(n + (late + self.insert_every - 1) / self.insert_every * self.insert_every)
+                } else {
+                    None
+                };
+            } else if n < sim.step {
                 return Err(Error::runtime(format!("Fix {} (id {}): 'start' step can not be before current step", self.style, self.id)));
             }
         }
@@ -1534,7 +1548,7 @@ impl Fix for LiggghtsInsert {
             InsertMode::Rate { ninsert: Some(t), .. } => self.ninserted < t,
             _ => true,
         };
-        self.next = if self.insert_every > 0 && more { self.next.map(|s| s + self.insert_every) } else { None };
+        self.schedule_next(more);
         Ok(())
     }
     fn end_of_step(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
