@@ -722,7 +722,9 @@ fn haff_cooling_of_a_nearly_elastic_gas() {
     let n_dens = nat as f64 / (l * l * l);
     let chi = (1.0 - 0.5 * phi) / (1.0 - phi).powi(3);
     let tau = 1.0 / (2.0 * PI.sqrt() / 3.0 * (1.0 - e * e) * n_dens * d * d * chi * vx);
-    let n = steps((0.8 * tau / dt) as u64, (8.0 * tau / dt) as u64);
+    // long: 4 tau (T falls 25-fold); later the homogeneous cooling state
+    // of a closed box gives way to clustering (Goldhirsch & Zanetti 1993)
+    let n = steps((0.8 * tau / dt) as u64, (4.0 * tau / dt) as u64);
     let every = (n / 100).max(1);
     let t0 = temp(&run);
     let mut prev = pot.total(&run) + wall_energy(&run);
@@ -1224,7 +1226,9 @@ fn fast_particles_cross_periodic_boundaries() {
         assert!((mom - p0).norm() <= 1e-10 * p0.norm(), "periodic drift: momentum {mom:?} vs {p0:?} at step {k}");
         let com = unwrapped_com(&run);
         let want = com0 + p0 / (64.0 * m) * run.time();
-        assert!((com - want).norm() <= 1e-9 * l, "periodic drift: centre of mass {com:?} vs {want:?} at step {k}");
+        // rounding grows with the distance travelled (wraps, time sums)
+        let travelled = (want - com0).norm();
+        assert!((com - want).norm() <= 1e-9 * (l + travelled), "periodic drift: centre of mass {com:?} vs {want:?} at step {k}");
         let e = comoving(&run);
         assert!(e <= e0 * (1.0 + 1e-3), "periodic drift: energy in the drifting frame {e} > {e0} at step {k}");
     }
