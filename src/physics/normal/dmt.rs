@@ -7,11 +7,15 @@
 //! damping F_damp = -eta_n v_n with eta_n as for the non-cohesive models
 //! (velocity, mass_velocity, viscoelastic eta a m*, tsuji alpha sqrt(m* k a)).
 //! The contact exists only while delta > 0 (the attraction switches on and
-//! off with the overlap). The friction, rolling and twisting caps use
-//! F_n0 = |F_ne + 2 F_pulloff| with F_pulloff = 4 pi gamma R* (doc, after
-//! Marshall 2009 eq. 43); DMT pull-off force is 4 pi gamma R* (= 2 pi w R*
-//! with the work of adhesion w = 2 gamma). `limit_damping` is rejected by
-//! LAMMPS for this model ("Cannot limit damping with DMT model", verified).
+//! off with the overlap); the DMT pull-off force is 4 pi gamma R*
+//! (= 2 pi w R* with the work of adhesion w = 2 gamma). The friction,
+//! rolling and twisting caps use F_n0 = |F_ne| (cohesion included, damping
+//! not): measured with the 29 Sep 2021 `lmp` on a sliding DMT contact,
+//! |F_t| / mu = |4/3 E_eff a delta - 4 pi gamma R*| to 7 digits over 20
+//! steps, **not** the |F_ne + 2 F_pulloff| the documentation states (that
+//! rule holds for `jkr` in this build, and for both in later versions).
+//! `limit_damping` is rejected by LAMMPS for this model ("Cannot limit
+//! damping with DMT model", verified).
 //!
 //! Verified with `lmp` (29 Sep 2021): E = 1e7, nu = 0.3, gamma = 0.1,
 //! R_i = R_j = 1 mm, delta = 10 um gives F = 4.5519509285241681e-3 N, equal
@@ -59,7 +63,8 @@ impl NormalLaw for LammpsDmt {
         let eta_n = p.gamma_n * damp_normal(self.damping, a, c.m_eff, k_n);
         out.fn_elastic = f_ne;
         out.fn_damp = -eta_n * c.vn;
-        out.fn_for_friction = f_ne + 2.0 * f_pulloff;
+        // LAMMPS 29 Sep 2021 behaviour (measured), see the module doc
+        out.fn_for_friction = f_ne;
         out.kn = k_n;
         out.kt = p.kt;
         out.a = a;
