@@ -509,3 +509,21 @@ fn jkr_oblique_sliding_like_lmp() {
         assert!(worst < TOL, "{worst}");
     }
 }
+
+/// `rolling sds` / `twisting sds` through `pair_coeff` (parsed since the
+/// twisting models came in): with a cohesive and a plain Hertz contact.
+#[test]
+fn sds_rolling_and_twisting_like_lmp() {
+    for (name, coeff) in [
+        ("jkr, twisting sds only", "jkr 1e7 2000 0.3 0.3 tangential linear_history 300 1.0 0.3 damping mass_velocity twisting sds 1e-5 1e-9 0.05"),
+        (
+            "hertz/material, rolling sds, twisting sds",
+            "hertz/material 1e7 2000 0.3 tangential mindlin NULL 1.0 0.3 damping mass_velocity rolling sds 100 1e-4 0.1 twisting sds 1e-5 1e-9 0.05",
+        ),
+    ] {
+        let c = Case { name, coeff, x0: x0_for(0.0008), yoff: 0.0008, v: 0.05, vt: 0.01, w: 100.0, steps: 1500 };
+        if let Some((worst, _)) = compare(&c) {
+            assert!(worst < TOL, "{name}: {worst}");
+        }
+    }
+}
