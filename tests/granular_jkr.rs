@@ -215,6 +215,8 @@ struct Case {
     vt: f64,
     w: f64,
     steps: u32,
+    /// Neighbour skin (m).
+    skin: f64,
 }
 
 /// The data file of a case (atom_style sphere: id type diameter density x y
@@ -257,7 +259,7 @@ boundary f f f
 newton off
 comm_modify vel yes
 read_data data.two
-neighbor 0.0005 bin
+neighbor {skin} bin
 neigh_modify delay 0
 pair_style granular
 pair_coeff * * {coeff}
@@ -268,7 +270,8 @@ dump_modify d format float %20.15g
 run {steps}
 ",
         coeff = c.coeff,
-        steps = c.steps
+        steps = c.steps,
+        skin = c.skin
     )
 }
 
@@ -366,6 +369,7 @@ fn jkr_headon_slow_sticks_like_lmp() {
         vt: 0.0,
         w: 0.0,
         steps: 4000,
+            skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -387,6 +391,7 @@ fn jkr_headon_fast_rebounds_like_lmp() {
         vt: 0.0,
         w: 0.0,
         steps: 2500,
+            skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -408,6 +413,7 @@ fn dmt_headon_sticks_slow_rebounds_fast_like_lmp() {
             vt: 0.0,
             w: 0.0,
             steps: 3000,
+            skin: 0.0005,
         };
         if let Some((worst, frames)) = compare(&c) {
             assert!(worst < TOL, "{}: {worst}", c.name);
@@ -433,6 +439,7 @@ fn jkr_oblique_rolling_twisting_marshall_like_lmp() {
         vt: 0.001,
         w: 20.0,
         steps: 3000,
+            skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -454,6 +461,7 @@ fn dmt_oblique_twisting_marshall_like_lmp() {
         vt: 0.01,
         w: 100.0,
         steps: 1500,
+            skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -480,6 +488,7 @@ fn limit_damping_with_cohesive_models_is_a_deck_error() {
             vt: 0.0,
             w: 0.0,
             steps: 10,
+            skin: 0.0005,
         };
         std::fs::write(dir.path().join("in.deck"), deck(&c)).unwrap();
         std::fs::write(dir.path().join("data.two"), data(&c)).unwrap();
@@ -504,6 +513,7 @@ fn jkr_oblique_sliding_like_lmp() {
         vt: 0.01,
         w: 100.0,
         steps: 1500,
+            skin: 0.0005,
     };
     if let Some((worst, _)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -521,9 +531,31 @@ fn sds_rolling_and_twisting_like_lmp() {
             "hertz/material 1e7 2000 0.3 tangential mindlin NULL 1.0 0.3 damping mass_velocity rolling sds 100 1e-4 0.1 twisting sds 1e-5 1e-9 0.05",
         ),
     ] {
-        let c = Case { name, coeff, x0: x0_for(0.0008), yoff: 0.0008, v: 0.05, vt: 0.01, w: 100.0, steps: 1500 };
+        let c = Case { name, coeff, x0: x0_for(0.0008), yoff: 0.0008, v: 0.05, vt: 0.01, w: 100.0, steps: 1500, skin: 0.0005 };
         if let Some((worst, _)) = compare(&c) {
             assert!(worst < TOL, "{name}: {worst}");
         }
+    }
+}
+
+/// LAMMPS 29 Sep 2021 lists pairs by radii + skin only, so with a skin
+/// smaller than the pull-off stretch a JKR contact ends when a rebuild drops
+/// the pair (verified: with neighbor 1e-8 lmp loses the contact as soon as
+/// the overlap turns negative); demx lists pairs the same way.
+#[test]
+fn jkr_stretched_contact_lives_within_the_skin_like_lmp() {
+    let c = Case {
+        name: "jkr head-on 20 mm/s, skin 10 nm",
+        coeff: "jkr 1e7 200 0.3 0.1 tangential mindlin NULL 1.0 0.5 damping mass_velocity",
+        x0: 0.001002,
+        yoff: 0.0,
+        v: 0.01,
+        vt: 0.0,
+        w: 0.0,
+        steps: 1500,
+        skin: 1e-8,
+    };
+    if let Some((worst, _)) = compare(&c) {
+        assert!(worst < TOL, "{worst}");
     }
 }

@@ -806,9 +806,14 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                     *t.get_mut(i, j) = pp;
                 }
             }
-            if let NormalSpec::GranularCohesive(CohesiveNormal::Jkr, _) = spec.normal {
-                jkr_neighbor_range(s, &mut t);
-            }
+            // JKR keeps a contact beyond touching, but LAMMPS 29 Sep 2021 lists
+            // pairs by radii + skin only (its `size` neighbour lists; the
+            // pull-off term of init_one's cutoff is negative and only sizes
+            // the bins): a stretched contact ends at delta_c or when a rebuild
+            // drops the pair (r > ri + rj + skin), whichever comes first
+            // (verified with neighbor 1e-8: lmp loses the contact at once
+            // when the overlap turns negative). demx lists pairs the same way,
+            // so no extra range here.
         }
         _ => {
             use crate::physics::mixing::{liggghts_pair_params, LiggghtsMaterials, LiggghtsSettings};
@@ -926,31 +931,6 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
         }
     }
     Ok(t)
-}
-
-/// JKR contacts last until the pull-off separation -delta_c (which grows
-/// with R*^(1/3)): the neighbour list of each type pair must reach that far
-/// beyond touching. As LAMMPS does, the range uses the largest radius of
-/// each type present now (R* of the two largest spheres bounds every pair's
-/// R*); spheres inserted later with larger radii may lose a stretched
-/// contact early once it leaves the skin.
-fn jkr_neighbor_range(s: &Session, t: &mut ParamTable) {
-    use crate::physics::normal::jkr::jkr_pulloff_overlap;
-    let nt = t.ntypes;
-    let p = &s.sim.particles;
-    let mut rmax = vec![0.0f64; nt + 1];
-    for (k, &r) in p.kind.iter().zip(&p.radius) {
-        if let Some(m) = rmax.get_mut(*k as usize) {
-            *m = m.max(r);
-        }
-    }
-    for i in 1..=nt {
-        for j in 1..=nt {
-            let (ri, rj) = (rmax[i], rmax[j]);
-            let pp = t.get_mut(i as u32, j as u32);
-            pp.extra_range = if ri > 0.0 && rj > 0.0 { -jkr_pulloff_overlap(ri * rj / (ri + rj), pp.y_eff, pp.cohesion) } else { 0.0 };
-        }
-    }
 }
 
 /// Before a run: build the kernel and coefficient table from the spec.
