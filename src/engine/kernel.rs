@@ -86,7 +86,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let (hn, rest) = hist.split_at_mut(N::HISTORY);
         let (hc, rest) = rest.split_at_mut(C::HISTORY);
         let (ht, hr) = rest.split_at_mut(T::HISTORY);
-        if c.delta > 0.0 {
+        let on = if N::CONTACT_ONLY { c.delta > 0.0 } else { self.normal.active(c, pp, hn) };
+        if on {
             self.normal.normal(c, pp, hn, &mut out);
             self.cohesion.cohesion(c, pp, hc, &mut out);
             self.tangential.tangential(c, pp, ht, &mut out);
@@ -178,13 +179,16 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             let pp = table.get(p.kind[i], p.kind[j]);
             // most listed pairs are within the skin but apart: decide on r^2
             // before building the contact
-            let reach = p.radius[i] + p.radius[j] + if C::NONCONTACT { pp.extra_range } else { 0.0 };
-            if (p.x[i] - xj).norm_squared() >= reach * reach {
+            // (a normal law acting beyond touching, JKR, decides itself in
+            // `apply`: its range depends on the radii, not only the types)
+            let beyond = C::NONCONTACT || !N::CONTACT_ONLY;
+            let reach = p.radius[i] + p.radius[j] + if beyond { pp.extra_range } else { 0.0 };
+            if N::CONTACT_ONLY && (p.x[i] - xj).norm_squared() >= reach * reach {
                 hist.fill(0.0);
                 return;
             }
             let Some((c, _)) = pair_contact(p, i, j, xj, dt) else { return };
-            if c.delta <= -pp.extra_range || (c.delta <= 0.0 && !C::NONCONTACT) {
+            if N::CONTACT_ONLY && (c.delta <= -pp.extra_range || (c.delta <= 0.0 && !C::NONCONTACT)) {
                 hist.fill(0.0);
                 return;
             }

@@ -187,8 +187,18 @@ pub struct PairParams {
 pub trait NormalLaw: Sync {
     /// History values this law keeps per contact.
     const HISTORY: usize;
-    /// Whether the law acts only when the surfaces touch.
+    /// Whether the law acts only when the surfaces touch. Laws that keep a
+    /// contact beyond touching (JKR) set it to false and decide in
+    /// [`NormalLaw::active`]; the kernel then also hands them pairs that are
+    /// apart.
     const CONTACT_ONLY: bool = true;
+    /// Whether the contact is on at this overlap, given the law's history
+    /// (zeroed whenever the contact was off). Consulted only when
+    /// `CONTACT_ONLY` is false; the default is `delta > 0`.
+    #[inline(always)]
+    fn active(&self, c: &Contact, _p: &PairParams, _hist: &[f64]) -> bool {
+        c.delta > 0.0
+    }
     /// Fill `fn_elastic`, `fn_damp`, `fn_for_friction`, `kn`, `kt`, `a`.
     fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
 }

@@ -40,6 +40,37 @@ pub enum NormalSpec {
     /// LAMMPS `pair_style granular`.
     #[serde(skip)]
     Granular(GranularNormal, GranularDamping),
+    /// LAMMPS `pair_style granular` cohesive normal models `dmt`, `jkr`.
+    #[serde(skip)]
+    GranularCohesive(CohesiveNormal, GranularDamping),
+}
+
+impl NormalSpec {
+    /// Whether this is a LAMMPS `pair_style granular` normal model (whose
+    /// coefficients come from `pair_coeff`).
+    pub fn is_lammps_granular(&self) -> bool {
+        matches!(self, NormalSpec::Granular(..) | NormalSpec::GranularCohesive(..))
+    }
+}
+
+/// Cohesive normal sub-models of LAMMPS `pair_style granular`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CohesiveNormal {
+    /// `dmt E eta nu gamma`.
+    Dmt,
+    /// `jkr E eta nu gamma`.
+    Jkr,
+}
+
+/// Twisting sub-model of LAMMPS `pair_style granular`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum GranularTwisting {
+    /// No twisting resistance (default).
+    None,
+    /// `twisting sds k gamma mu`.
+    Sds,
+    /// `twisting marshall`.
+    Marshall,
 }
 
 /// Tangential law of a scene.
@@ -108,10 +139,12 @@ pub enum RollingSpec {
         /// `torsionTorque on`.
         torsion: bool,
     },
-    /// LAMMPS granular `rolling sds` (with `twisting sds` when set).
-    Sds {
-        /// `twisting sds` too.
-        twisting: bool,
+    /// LAMMPS granular `rolling sds` and/or a twisting model.
+    Lammps {
+        /// `rolling sds` given.
+        rolling: bool,
+        /// Twisting model.
+        twisting: GranularTwisting,
     },
 }
 
@@ -189,6 +222,7 @@ impl PairSpec {
             NormalSpec::GranHooke => "hooke (LAMMPS gran)".into(),
             NormalSpec::GranHertz => "hertz (LAMMPS gran)".into(),
             NormalSpec::Granular(m, d) => format!("{m:?} damping {d:?} (LAMMPS granular)").to_lowercase(),
+            NormalSpec::GranularCohesive(m, d) => format!("{m:?} damping {d:?} (LAMMPS granular)").to_lowercase(),
         };
         let t = match self.tangential {
             TangentialSpec::LigNoHistory | TangentialSpec::GranNoHistory | TangentialSpec::LinearNoHistory => "tangential no_history".to_string(),
@@ -209,7 +243,18 @@ impl PairSpec {
             RollingSpec::Epsd2 { .. } => "epsd2".into(),
             RollingSpec::Epsd3 { .. } => "epsd3".into(),
             RollingSpec::PaperEpsd { .. } => "epsd/paper".into(),
-            RollingSpec::Sds { twisting } => if twisting { "sds + twisting sds".into() } else { "sds".into() },
+            RollingSpec::Lammps { rolling, twisting } => {
+                let tw = match twisting {
+                    GranularTwisting::None => "",
+                    GranularTwisting::Sds => "twisting sds",
+                    GranularTwisting::Marshall => "twisting marshall",
+                };
+                match (rolling, tw.is_empty()) {
+                    (true, true) => "sds".into(),
+                    (true, false) => format!("sds + {tw}"),
+                    (false, _) => tw.to_string(),
+                }
+            }
         };
         format!("{n} + {t}; cohesion: {c}; rolling: {r}")
     }
@@ -220,8 +265,9 @@ impl PairSpec {
 /// Build the kernel for a spec: one generic step per model axis. The deck
 /// language only combines laws of one engine (LIGGGHTS `pair_style gran` or
 /// LAMMPS `gran/*` / `granular`), so the walk is split by dialect: every
-/// combination a deck can express compiles (LIGGGHTS 4 x 2 x 3 x 5, LAMMPS
-/// 3 x 4 x 2), none that no deck can express.
+/// combination a deck can express compiles (LIGGGHTS 5 x 3 x 4 x 6; LAMMPS
+/// gran/* 2 x 2; LAMMPS granular 3 normal laws x 2 tangential x 5
+/// rolling/twisting), none that no deck can express.
 pub fn build_kernel(spec: &PairSpec) -> Result<Box<dyn ContactKernel>> {
     let k = match spec.normal {
         NormalSpec::LigHooke { kt_to_kn } => lig_tangential(normal::hooke::LiggghtsHooke { kt_to_kn }, spec),
@@ -231,9 +277,11 @@ pub fn build_kernel(spec: &PairSpec) -> Result<Box<dyn ContactKernel>> {
         NormalSpec::LigHertz => lig_tangential(normal::hertz::LiggghtsHertz, spec),
         NormalSpec::LigHertzStiffness => lig_tangential(normal::hertz_stiffness::LiggghtsHertzStiffness, spec),
         NormalSpec::PaperViscoelastic => lig_tangential(normal::viscoelastic::PaperViscoelastic, spec),
-        NormalSpec::GranHooke => lmp_tangential(normal::gran::LammpsGranHooke, spec),
-        NormalSpec::GranHertz => lmp_tangential(normal::gran::LammpsGranHertz, spec),
+        NormalSpec::GranHooke => gran_tangential(normal::gran::LammpsGranHooke, spec),
+        NormalSpec::GranHertz => gran_tangential(normal::gran::LammpsGranHertz, spec),
         NormalSpec::Granular(model, damping) => lmp_tangential(normal::granular::LammpsGranular { model, damping }, spec),
+        NormalSpec::GranularCohesive(CohesiveNormal::Dmt, damping) => lmp_tangential(normal::dmt::LammpsDmt { damping }, spec),
+        NormalSpec::GranularCohesive(CohesiveNormal::Jkr, damping) => lmp_tangential(normal::jkr::LammpsJkr { damping }, spec),
     };
     k.ok_or_else(|| Error::deck(spec.span, format!("contact model mixes LIGGGHTS and LAMMPS laws: {}", spec.summary())))
 }
@@ -271,17 +319,29 @@ where
         RollingSpec::Epsd2 { torsion } => finish(n, t, c, LiggghtsEpsd2 { torsion_torque: torsion }),
         RollingSpec::Epsd3 { torsion } => finish(n, t, c, LiggghtsEpsd3 { torsion_torque: torsion }),
         RollingSpec::PaperEpsd { torsion } => finish(n, t, c, crate::physics::rolling::paper::PaperEpsd { torsion_torque: torsion }),
-        RollingSpec::Sds { .. } => return None,
+        RollingSpec::Lammps { .. } => return None,
     })
 }
 
+/// LAMMPS `pair_style gran/*`: its own tangential laws, no rolling.
+fn gran_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
+    if spec.cohesion != CohesionSpec::Off || spec.rolling != RollingSpec::Off {
+        return None;
+    }
+    match spec.tangential {
+        TangentialSpec::GranNoHistory => Some(finish(n, tangential::gran::LammpsGranNoHistory, NoCohesion, NoRolling)),
+        TangentialSpec::GranHistory => Some(finish(n, tangential::gran::LammpsGranHistory, NoCohesion, NoRolling)),
+        _ => None,
+    }
+}
+
+/// LAMMPS `pair_style granular`: its tangential, rolling and twisting
+/// sub-models.
 fn lmp_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
     if spec.cohesion != CohesionSpec::Off {
         return None;
     }
     match spec.tangential {
-        TangentialSpec::GranNoHistory => lmp_rolling(n, tangential::gran::LammpsGranNoHistory, spec),
-        TangentialSpec::GranHistory => lmp_rolling(n, tangential::gran::LammpsGranHistory, spec),
         TangentialSpec::LinearNoHistory => lmp_rolling(n, tangential::granular::LammpsLinearNoHistory, spec),
         TangentialSpec::Granular(model) => lmp_rolling(n, tangential::granular::LammpsGranularHistory { model }, spec),
         _ => None,
@@ -289,10 +349,15 @@ fn lmp_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Optio
 }
 
 fn lmp_rolling<N: NormalLaw + Send + 'static, T: TangentialLaw + Send + 'static>(n: N, t: T, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
+    use crate::physics::rolling::marshall::{LammpsSdsMarshall, LammpsTwistMarshall};
     use crate::physics::rolling::sds::LammpsSds;
     Some(match spec.rolling {
-        RollingSpec::Off => finish(n, t, NoCohesion, NoRolling),
-        RollingSpec::Sds { twisting } => finish(n, t, NoCohesion, LammpsSds { twisting }),
+        RollingSpec::Off | RollingSpec::Lammps { rolling: false, twisting: GranularTwisting::None } => finish(n, t, NoCohesion, NoRolling),
+        RollingSpec::Lammps { rolling: true, twisting: GranularTwisting::None } => finish(n, t, NoCohesion, LammpsSds { twisting: false }),
+        // twisting sds alone: the rolling part sees zero coefficients and adds nothing
+        RollingSpec::Lammps { twisting: GranularTwisting::Sds, .. } => finish(n, t, NoCohesion, LammpsSds { twisting: true }),
+        RollingSpec::Lammps { rolling: false, twisting: GranularTwisting::Marshall } => finish(n, t, NoCohesion, LammpsTwistMarshall),
+        RollingSpec::Lammps { rolling: true, twisting: GranularTwisting::Marshall } => finish(n, t, NoCohesion, LammpsSdsMarshall),
         _ => return None,
     })
 }
@@ -319,22 +384,19 @@ pub fn execute(s: &mut Session, cmd: &Command) -> Result<()> {
         let ti = a.word("type I")?;
         let tj = a.word("type J")?;
         spec.has_coeff = true;
-        if let NormalSpec::Granular(..) = spec.normal {
+        if spec.normal.is_lammps_granular() {
             let ntypes = s.sim.ntypes.max(1) as u32;
             let (ilo, ihi) = type_range(ti, ntypes)?;
             let (jlo, jhi) = type_range(tj, ntypes)?;
-            let (normal, tang, pp) = parse_granular_coeff(&mut a)?;
+            let (normal, tang, roll, pp) = parse_granular_coeff(&mut a)?;
             // demx runs one granular sub-model per scene
             let first = spec.granular.is_empty();
-            if !first {
-                if let (NormalSpec::Granular(m, d), TangentialSpec::Granular(_) | TangentialSpec::LinearNoHistory) = (spec.normal, spec.tangential) {
-                    if normal != NormalSpec::Granular(m, d) || tang != spec.tangential {
-                        return Err(Error::unsupported(cmd.span, "different pair_style granular sub-models for different type pairs"));
-                    }
-                }
+            if !first && (normal != spec.normal || tang != spec.tangential || roll != spec.rolling) {
+                return Err(Error::unsupported(cmd.span, "different pair_style granular sub-models for different type pairs"));
             }
             spec.normal = normal;
             spec.tangential = tang;
+            spec.rolling = roll;
             for i in ilo..=ihi {
                 for j in jlo..=jhi {
                     spec.granular.push((i, j, pp));
@@ -552,15 +614,21 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
     Ok(())
 }
 
+/// One LAMMPS granular `pair_coeff` as parsed: normal, tangential and
+/// rolling/twisting choices and the pair's coefficients.
+type GranularChoice = (NormalSpec, TangentialSpec, RollingSpec, PairParams);
+
 /// LAMMPS `pair_coeff I J <normal> ... tangential ... [damping ...] [rolling ...] [twisting ...] [limit_damping]`.
-fn parse_granular_coeff(a: &mut Args) -> Result<(NormalSpec, TangentialSpec, PairParams)> {
+fn parse_granular_coeff(a: &mut Args) -> Result<GranularChoice> {
     let mut pp = PairParams::default();
     let m = a.word("normal model")?;
-    let model = match m.text.as_str() {
-        "hooke" => GranularNormal::Hooke,
-        "hertz" => GranularNormal::Hertz,
-        "hertz/material" => GranularNormal::HertzMaterial,
-        "dmt" | "jkr" => return Err(Error::unsupported(m.span, format!("pair_style granular normal model '{}'", m.text))),
+    // None: hooke/hertz/hertz-material family; Some: dmt, jkr
+    let (model, cohesive) = match m.text.as_str() {
+        "hooke" => (GranularNormal::Hooke, None),
+        "hertz" => (GranularNormal::Hertz, None),
+        "hertz/material" => (GranularNormal::HertzMaterial, None),
+        "dmt" => (GranularNormal::HertzMaterial, Some(CohesiveNormal::Dmt)),
+        "jkr" => (GranularNormal::HertzMaterial, Some(CohesiveNormal::Jkr)),
         _ => return Err(bad_keyword(m, "normal model", &["hooke", "hertz", "hertz/material", "dmt", "jkr"])),
     };
     let mut e_young = 0.0;
@@ -574,6 +642,16 @@ fn parse_granular_coeff(a: &mut Args) -> Result<(NormalSpec, TangentialSpec, Pai
             // E_eff for `pair_coeff` of identical materials: E / (2 (1 - nu^2)); k_n = 4/3 E_eff
             pp.y_eff = e_young / (2.0 * (1.0 - poisson * poisson));
             pp.kn = 4.0 / 3.0 * pp.y_eff;
+            if cohesive.is_some() {
+                let g = a.word("surface energy gamma")?;
+                pp.cohesion = parse_f64(g)?;
+                if !(pp.cohesion >= 0.0) || !pp.cohesion.is_finite() {
+                    return Err(Error::deck(g.span, format!("{}: surface energy {} must be >= 0", m.text, g.text)));
+                }
+                if !(e_young > 0.0) || !e_young.is_finite() || !(poisson > -1.0 && poisson < 1.0) {
+                    return Err(Error::deck(m.span, format!("{}: needs E > 0 and -1 < poisson < 1", m.text)));
+                }
+            }
         }
         _ => {
             pp.kn = a.f64("kn")?;
@@ -582,6 +660,8 @@ fn parse_granular_coeff(a: &mut Args) -> Result<(NormalSpec, TangentialSpec, Pai
     }
     let mut damping = GranularDamping::Viscoelastic;
     let mut tang = None;
+    let mut rolling = false;
+    let mut twisting = GranularTwisting::None;
     while a.more() {
         let k = a.word("keyword")?;
         match k.text.as_str() {
@@ -604,8 +684,8 @@ fn parse_granular_coeff(a: &mut Args) -> Result<(NormalSpec, TangentialSpec, Pai
                             _ => GranularTangential::MindlinRescaleForce,
                         };
                         pp.kt = if ktw.text == "NULL" {
-                            if model == GranularTangential::LinearHistory || model != GranularTangential::LinearHistory && e_young == 0.0 {
-                                return Err(Error::deck(ktw.span, "kt NULL needs normal model hertz/material"));
+                            if model == GranularTangential::LinearHistory || e_young == 0.0 {
+                                return Err(Error::deck(ktw.span, "kt NULL needs a material normal model (hertz/material, dmt, jkr)"));
                             }
                             // 8 G_eff with G = E / (2 (1 + nu)), identical materials
                             let g = e_young / (2.0 * (1.0 + poisson));
@@ -638,8 +718,40 @@ fn parse_granular_coeff(a: &mut Args) -> Result<(NormalSpec, TangentialSpec, Pai
                     _ => return Err(bad_keyword(d, "damping model", &["velocity", "mass_velocity", "viscoelastic", "tsuji"])),
                 };
             }
-            "rolling" | "twisting" => return Err(Error::unsupported(k.span, format!("pair_style granular {} models", k.text))),
-            "limit_damping" => pp.limit_damping = 1.0,
+            "rolling" => {
+                let r = a.word("rolling model")?;
+                match r.text.as_str() {
+                    "none" => rolling = false,
+                    "sds" => {
+                        pp.k_roll = a.f64("k_roll")?;
+                        pp.gamma_roll = a.f64("gamma_roll")?;
+                        pp.mu_r = a.f64("mu_roll")?;
+                        rolling = true;
+                    }
+                    _ => return Err(bad_keyword(r, "rolling model", &["none", "sds"])),
+                }
+            }
+            "twisting" => {
+                let t = a.word("twisting model")?;
+                twisting = match t.text.as_str() {
+                    "none" => GranularTwisting::None,
+                    "sds" => {
+                        pp.k_twist = a.f64("k_twist")?;
+                        pp.gamma_twist = a.f64("gamma_twist")?;
+                        pp.mu_twist = a.f64("mu_twist")?;
+                        GranularTwisting::Sds
+                    }
+                    "marshall" => GranularTwisting::Marshall,
+                    _ => return Err(bad_keyword(t, "twisting model", &["none", "sds", "marshall"])),
+                };
+            }
+            "limit_damping" => {
+                if let Some(c) = cohesive {
+                    // LAMMPS 29 Sep 2021: "Cannot limit damping with DMT model" / "... JKR model"
+                    return Err(Error::deck(k.span, format!("Cannot limit damping with {} model", if c == CohesiveNormal::Dmt { "DMT" } else { "JKR" })));
+                }
+                pp.limit_damping = 1.0
+            }
             "cutoff" => {
                 a.f64("cutoff")?;
             }
@@ -655,7 +767,12 @@ fn parse_granular_coeff(a: &mut Args) -> Result<(NormalSpec, TangentialSpec, Pai
         pp.gamma_n = 1.2728 - 4.2783 * e + 11.087 * e * e - 22.348 * e.powi(3) + 27.467 * e.powi(4) - 18.022 * e.powi(5) + 4.8218 * e.powi(6);
     }
     pp.tangential_damping = 1.0;
-    Ok((NormalSpec::Granular(model, damping), tang, pp))
+    let normal = match cohesive {
+        None => NormalSpec::Granular(model, damping),
+        Some(c) => NormalSpec::GranularCohesive(c, damping),
+    };
+    let roll = if rolling || twisting != GranularTwisting::None { RollingSpec::Lammps { rolling, twisting } } else { RollingSpec::Off };
+    Ok((normal, tang, roll, pp))
 }
 
 // ---------------------------------------------------------------- materials
@@ -683,12 +800,20 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                 p.limit_damping = if spec.limit_damping { 1.0 } else { 0.0 };
             }
         }
-        NormalSpec::Granular(..) => {
+        NormalSpec::Granular(..) | NormalSpec::GranularCohesive(..) => {
             for &(i, j, pp) in &spec.granular {
                 if (i as usize) <= nt && (j as usize) <= nt {
                     *t.get_mut(i, j) = pp;
                 }
             }
+            // JKR keeps a contact beyond touching, but LAMMPS 29 Sep 2021 lists
+            // pairs by radii + skin only (its `size` neighbour lists; the
+            // pull-off term of init_one's cutoff is negative and only sizes
+            // the bins): a stretched contact ends at delta_c or when a rebuild
+            // drops the pair (r > ri + rj + skin), whichever comes first
+            // (verified with neighbor 1e-8: lmp loses the contact at once
+            // when the overlap turns negative). demx lists pairs the same way,
+            // so no extra range here.
         }
         _ => {
             use crate::physics::mixing::{liggghts_pair_params, LiggghtsMaterials, LiggghtsSettings};
@@ -814,7 +939,7 @@ pub fn finalize(s: &mut Session, _cmd: &Command) -> Result<()> {
         s.sim.model = None;
         return Ok(());
     };
-    if matches!(spec.normal, NormalSpec::Granular(..)) && spec.granular.is_empty() {
+    if spec.normal.is_lammps_granular() && spec.granular.is_empty() {
         return Err(Error::deck(spec.span, "pair_style granular needs pair_coeff lines"));
     }
     if !spec.has_coeff && !matches!(spec.normal, NormalSpec::GranHooke | NormalSpec::GranHertz) {

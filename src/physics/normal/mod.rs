@@ -4,7 +4,8 @@
 //! [`hertz`], [`hertz_stiffness`]. LAMMPS `pair_style gran/hooke`,
 //! `gran/hooke/history`, `gran/hertz/history`: [`gran`]. LAMMPS
 //! `pair_style granular` normal sub-models hooke, hertz, hertz/material with
-//! the damping variants: [`granular`].
+//! the damping variants: [`granular`]; the cohesive sub-models `dmt` and
+//! `jkr`: [`dmt`], [`jkr`].
 //!
 //! Every law fills `fn_elastic`, `fn_damp`, `fn_for_friction` (the signed
 //! normal force the friction cap takes the absolute value of), `kn`, `kt`,
@@ -17,6 +18,8 @@ pub mod hertz;
 pub mod hertz_stiffness;
 pub mod gran;
 pub mod granular;
+pub mod dmt;
+pub mod jkr;
 pub mod viscoelastic;
 
 use super::ContactOut;

@@ -1,7 +1,8 @@
 //! Rolling (and twisting) resistance laws, one file per deck keyword:
 //! LIGGGHTS `rolling_friction cdt`, `epsd`, `epsd2`, `epsd3`
 //! ([`cdt`], [`epsd`], [`epsd2`], [`epsd3`]) and LAMMPS granular
-//! `rolling sds` / `twisting sds` ([`sds`]).
+//! `rolling sds` / `twisting sds` ([`sds`]) and `twisting marshall`
+//! ([`marshall`]).
 //!
 //! LIGGGHTS conventions (sources `rolling_model_*.h`): the relative rotation
 //! is w_i - w_j for pairs with R*; for walls it is the surface model's
@@ -14,6 +15,7 @@ pub mod epsd;
 pub mod epsd2;
 pub mod epsd3;
 pub mod sds;
+pub mod marshall;
 pub mod paper;
 
 use super::{Contact, ContactOut, PairParams, V3};
