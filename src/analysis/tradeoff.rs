@@ -586,7 +586,7 @@ pub fn tradeoff(a: &TradeoffArgs, progress: &mut dyn FnMut(&str)) -> Result<Trad
                 "{lab}{}: {} ({:.2} s)",
                 seed.map_or(String::new(), |s| format!(" seed {s}")),
                 match (&r.value, &r.error) {
-                    (Some(v), _) => format!("{} = {v:.6}", metric.label()),
+                    (Some(v), _) => format!("{} = {}", metric.label(), num(*v, 6)),
                     (None, Some(e)) => format!("FAILED: {e}"),
                     _ => "?".into(),
                 },
@@ -634,11 +634,14 @@ pub fn tradeoff(a: &TradeoffArgs, progress: &mut dyn FnMut(&str)) -> Result<Trad
     Ok(Tradeoff { deck: a.deck.display().to_string(), metric, reference_value: rv, reference, rows, notes })
 }
 
+/// `p` decimals, or `p` significant digits in exponent form for values far from 1.
 fn num(v: f64, p: usize) -> String {
-    if v.is_finite() {
-        format!("{v:.p$}")
-    } else {
+    if !v.is_finite() {
         "-".into()
+    } else if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) {
+        format!("{v:.p$e}")
+    } else {
+        format!("{v:.p$}")
     }
 }
 
