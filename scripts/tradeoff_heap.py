@@ -87,7 +87,7 @@ def table(data, name):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--demx", default=os.path.join(ROOT, "target", "release", "demx"))
-    ap.add_argument("--n", type=int, default=2000)
+    ap.add_argument("--n", type=int, default=None, help="particles (default 2000; --quick: 300)")
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--quick", action="store_true")
@@ -101,9 +101,10 @@ def main():
             sys.exit(f"no demx binary at {a.demx} (cargo build --release)")
     deck = os.path.join(ROOT, "templates", "heap", "in.heap")
     if a.quick:
-        a.n, a.seeds = 300, 1
+        a.n, a.seeds = a.n or 300, 1
         y_main, y_extra, dtf = ["1e7", "1e8"], [], ["0.3", "0.1"]
     else:
+        a.n = a.n or 2000
         y_main, y_extra, dtf = ["1e7", "1e8", "1e9"], ["1e10"], ["0.3", "0.2", "0.1", "0.05"]
 
     # 1. stiffness: the reference is the stiffest Y of the 3-seed study
