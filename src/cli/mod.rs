@@ -53,6 +53,16 @@ enum Cmd {
         /// Run at most this many steps per `run` command (smoke tests).
         #[arg(long)]
         max_steps: Option<i64>,
+        /// Time step as this fraction of the Hertz collision time (as `demx
+        /// check` reports it), replacing the deck's `timestep` (applied at the
+        /// `timestep` command, or at the first run if the particles are not
+        /// known yet). Run lengths stay the deck's step counts.
+        #[arg(long, value_name = "F")]
+        dt_fraction: Option<f64>,
+        /// Divide every stiffness (Young's and shear moduli, kn, kt; pairs and
+        /// walls) by S: softer particles allow longer time steps.
+        #[arg(long, value_name = "S")]
+        youngs_scale: Option<f64>,
     },
     /// Read and validate a deck without running it; print a summary.
     Check {
@@ -168,9 +178,18 @@ fn normalise_args(args: Vec<String>) -> Vec<String> {
 
 /// Run a deck in a session; returns the session (for summaries) or the error
 /// with the source map to render it.
-pub fn run_deck(deck: &DeckArgs, check: bool, threads: usize, log: Option<&str>, quiet: bool, max_steps: Option<i64>) -> (Session, SourceMap, Result<()>) {
+pub fn run_deck(
+    deck: &DeckArgs,
+    check: bool,
+    threads: usize,
+    log: Option<&str>,
+    quiet: bool,
+    max_steps: Option<i64>,
+    overrides: crate::scene::overrides::Overrides,
+) -> (Session, SourceMap, Result<()>) {
     let sources = SourceMap::new();
     let mut session = Session::new(check);
+    session.overrides = overrides;
     session.threads = threads;
     session.max_steps = max_steps;
     session.perturb = deck.perturb;
@@ -212,8 +231,12 @@ pub fn main() -> ExitCode {
         }
     };
     match cli.cmd {
-        Cmd::Run { mut deck, threads, log, quiet, max_steps } => {
+        Cmd::Run { mut deck, threads, log, quiet, max_steps, dt_fraction, youngs_scale } => {
             deck.var_groups = groups.clone();
+            let overrides = match crate::scene::overrides::Overrides::new(dt_fraction, youngs_scale) {
+                Ok(o) => o,
+                Err(e) => return report(&e, &SourceMap::new()),
+            };
             // the whole run executes on a pool thread: parallel passes then
             // run inline (one thread) or fork from a worker, without waking
             // the pool from outside every step
@@ -224,7 +247,7 @@ pub fn main() -> ExitCode {
                     return ExitCode::from(1);
                 }
             };
-            let (_s, sources, r) = pool.install(|| run_deck(&deck, false, threads, Some(&log), quiet, max_steps));
+            let (_s, sources, r) = pool.install(|| run_deck(&deck, false, threads, Some(&log), quiet, max_steps, overrides));
             match r {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => report(&e, &sources),
@@ -250,7 +273,7 @@ pub fn main() -> ExitCode {
         }
         Cmd::Check { mut deck, json, .. } => {
             deck.var_groups = groups.clone();
-            let (s, sources, r) = run_deck(&deck, true, 1, None, true, None);
+            let (s, sources, r) = run_deck(&deck, true, 1, None, true, None, Default::default());
             match r {
                 Ok(()) => {
                     let sum = Summary::of(&s);

@@ -15,6 +15,7 @@ pub mod restart;
 pub mod insert;
 pub mod mesh;
 pub mod wind;
+pub mod overrides;
 
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{did_you_mean, Error, Result};
@@ -91,6 +92,8 @@ pub struct Session {
     /// Commands that define units, materials and the contact model, replayed
     /// by `read_restart`.
     pub replay: Vec<String>,
+    /// Command-line accuracy overrides (`demx run --dt-fraction/--youngs-scale`).
+    pub overrides: overrides::Overrides,
 }
 
 /// Commands that only tune MPI, communication or memory: accepted, recorded,
@@ -172,6 +175,7 @@ impl Session {
             walls: vec![],
             sources: vec![],
             replay: vec![],
+            overrides: overrides::Overrides::default(),
         }
     }
 
@@ -210,7 +214,14 @@ impl Session {
         match name {
             "units" | "atom_style" | "boundary" | "dimension" | "neighbor" | "neigh_modify" | "timestep" | "hard_particles"
             | "soft_particles" | "region" | "create_box" | "lattice" | "create_atoms" | "group" | "set"
-            | "velocity" | "delete_atoms" | "displace_atoms" | "reset_timestep" | "mass" | "change_box" => setup::execute(self, cmd, vars),
+            | "velocity" | "delete_atoms" | "displace_atoms" | "reset_timestep" | "mass" | "change_box" => {
+                setup::execute(self, cmd, vars)?;
+                // demx run --dt-fraction: replaces the deck's time step
+                if name == "timestep" {
+                    overrides::after_timestep(self);
+                }
+                Ok(())
+            }
             "write_data" | "write_restart" | "read_restart" | "read_data" | "restart" => restart::execute(self, cmd, vars),
             "pair_style" | "pair_coeff" => model::execute(self, cmd),
             "fix" | "unfix" => self.fix_command(cmd, vars),
@@ -303,6 +314,8 @@ impl Session {
         if let Some((seed, amp)) = self.perturb.take().filter(|_| !self.check) {
             perturb_positions(&mut self.sim.particles, seed, amp);
         }
+        // demx run --dt-fraction, when no `timestep` command could apply it
+        overrides::before_run(self, cmd.words[0].span)?;
         self.schedule.push(RunRecord { steps, start: self.sim.step, particles: self.sim.particles.len() });
         self.sim.run_bounds = Some((start.unwrap_or(self.sim.step), stop.unwrap_or(self.sim.step + steps)));
         if !self.sim.fixes.iter().any(|f| f.integrates()) && !self.check {

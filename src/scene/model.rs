@@ -930,6 +930,8 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
             }
         }
     }
+    // demx run --youngs-scale: every stiffness divided (pairs and walls)
+    super::overrides::scale_table(s, &mut t);
     Ok(t)
 }
 

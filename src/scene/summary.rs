@@ -124,6 +124,8 @@ pub fn timestep_check(s: &Session) -> Option<TimestepCheck> {
             }
             _ => (0.0, 0.0),
         };
+        // demx run --youngs-scale divides every stiffness
+        let y = y / s.overrides.stiffness_divisor();
         let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * rho;
         let m_eff = 0.5 * m;
         let (tr, th) = if y > 0.0 {
@@ -139,6 +141,7 @@ pub fn timestep_check(s: &Session) -> Option<TimestepCheck> {
                 NormalSpec::GranHooke => spec.gran.map(|g| g[0]).unwrap_or(0.0),
                 _ => s.props.get("kn").and_then(|(_, v)| v.get(1).copied()).unwrap_or(0.0),
             };
+            let kn = kn / s.overrides.stiffness_divisor();
             if kn <= 0.0 {
                 continue;
             }
