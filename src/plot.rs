@@ -77,8 +77,6 @@ const MARGIN: u32 = 12;
 const X_LABEL_AREA: u32 = 44;
 /// Width of the area left of the plot (tick labels + y label), pixels.
 const Y_LABEL_AREA: u32 = 78;
-/// Height taken by a panel title, pixels.
-const TITLE_AREA: u32 = 28;
 
 /// Colours of successive series (the "tab10" palette).
 const PALETTE: [RGBColor; 10] = [
@@ -207,6 +205,14 @@ fn save_atomically(path: &Path, buf: &[u8], (w, h): (u32, u32)) -> Result<()> {
         bm.blit_bitmap((0, 0), (w, h), buf).map_err(|e| io(&e))?;
         bm.present().map_err(|e| io(&e))?;
     }
+    // The temporary file is private (0600); give the plot the usual mode,
+    // or keep the one of the file it replaces.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(path).map(|m| m.permissions()).unwrap_or_else(|_| std::fs::Permissions::from_mode(0o644));
+        tmp.as_file().set_permissions(mode).map_err(|e| io(&e))?;
+    }
     tmp.persist(path).map_err(|e| io(&e.error))?;
     Ok(())
 }
@@ -299,22 +305,23 @@ fn draw_panel(area: &DrawingArea<BitMapBackend, plotters::coord::Shift>, c: &Cha
     let ys = c.series.iter().flat_map(|s| series_values(s, true));
     let mut sx = Span::of(xs, c.log_x);
     let mut sy = Span::of(ys, c.log_y);
-    let (title_h, xl, yl) = if text { (if c.title.is_empty() { 0 } else { TITLE_AREA }, X_LABEL_AREA, Y_LABEL_AREA) } else { (0, 0, 0) };
+    let (xl, yl) = if text { (X_LABEL_AREA, Y_LABEL_AREA) } else { (0, 0) };
+    // The title takes its own strip, so the plot's pixel size is known
+    // exactly (equal aspect needs it).
+    let area = if text && !c.title.is_empty() { area.titled(&c.title, (FAMILY, 18)).map_err(|e| e.to_string())? } else { area.clone() };
     if c.equal_aspect && !c.log_x && !c.log_y {
         let (w, h) = area.dim_in_pixel();
-        let pw = w.saturating_sub(2 * MARGIN + yl).max(1) as f64;
-        let ph = h.saturating_sub(2 * MARGIN + xl + title_h).max(1) as f64;
+        // plotters maps the range onto pixels 0 ..= size - 1
+        let pw = w.saturating_sub(2 * MARGIN + yl + 1).max(1) as f64;
+        let ph = h.saturating_sub(2 * MARGIN + xl + 1).max(1) as f64;
         let scale = (sx.width() / pw).max(sy.width() / ph);
         if scale.is_finite() && scale > 0.0 {
             sx.widen(scale * pw);
             sy.widen(scale * ph);
         }
     }
-    let mut b = ChartBuilder::on(area);
+    let mut b = ChartBuilder::on(&area);
     b.margin(MARGIN).x_label_area_size(xl).y_label_area_size(yl);
-    if text && !c.title.is_empty() {
-        b.caption(&c.title, (FAMILY, 18));
-    }
     let (x, y) = (sx.lo..sx.hi, sy.lo..sy.hi);
     match (c.log_x, c.log_y) {
         (false, false) => finish(b, x, y, c, text),

@@ -102,6 +102,12 @@ fn two_panels_give_a_png_of_two_panel_widths_with_the_series_drawn() {
         let dark = (0..30).flat_map(|y| (0..img.w).map(move |x| (x, y))).filter(|&(x, y)| img.rgb(x, y).iter().all(|&c| c < 100)).count();
         assert!(dark > 50, "title text drawn: {dark} px");
     }
+    // readable like any other output (the temporary file is private)
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        assert_eq!(std::fs::metadata(&p).unwrap().permissions().mode() & 0o777, 0o644);
+    }
     // no temporary file left beside the result
     let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(names, vec![std::ffi::OsString::from("out.png")]);
