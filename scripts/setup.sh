@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Installs what demx's tests and comparisons need on a fresh Debian machine:
 # the real engines (LIGGGHTS 3.8 and LAMMPS with the GRANULAR package) and their
-# example decks. Safe to rerun; does nothing when everything is present.
+# example decks, and the font of `--plot` charts (fonts-dejavu-core). Safe to
+# rerun; does nothing when everything is present.
 set -euo pipefail
 need=()
 command -v liggghts >/dev/null 2>&1 || need+=(liggghts)
 command -v lmp >/dev/null 2>&1 || need+=(lammps)
 [ -d /usr/share/doc/liggghts/examples ] || need+=(liggghts-doc)
 [ -d /usr/share/lammps/examples ] || need+=(lammps-examples)
+[ -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || need+=(fonts-dejavu-core)
 if [ ${#need[@]} -gt 0 ]; then
   SUDO=""
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"

@@ -825,6 +825,10 @@ pub struct CompareArgs {
     /// Perturbation of the ensemble members, in particle radii.
     #[arg(long, default_value_t = 1e-6)]
     pub perturb: f64,
+    /// Two-run mode: draw position deviation and kinetic energies vs
+    /// timestep into this PNG file.
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<PathBuf>,
     /// Variables for --against runs (filled from `-var NAME VALUE...`).
     #[arg(skip)]
     pub vars: Vec<(String, Vec<String>)>,
@@ -877,14 +881,69 @@ pub fn report(args: &CompareArgs, cs: &[Comparison], extra: Option<serde_json::V
     Ok(ExitCode::from(if pass { 0 } else { 1 }))
 }
 
+/// The `--plot` charts: RMS and largest position deviation (diameters, log
+/// scale) with the position tolerance, and the kinetic energy of each run,
+/// against the timestep.
+pub fn charts(cs: &[Comparison]) -> Vec<crate::plot::Chart> {
+    use crate::plot::{Chart, Series, SeriesKind};
+    let mut dev = Chart {
+        title: "position deviation B - A".into(),
+        x_label: "timestep".into(),
+        y_label: "deviation / particle diameter".into(),
+        log_y: true,
+        ..Chart::default()
+    };
+    let ke_unit = if cs.iter().any(|c| c.notes.iter().any(|n| n.contains("per unit density"))) { "J/(kg/m^3)" } else { "J" };
+    let mut ke = Chart {
+        title: "kinetic energy".into(),
+        x_label: "timestep".into(),
+        y_label: format!("translational KE ({ke_unit})"),
+        ..Chart::default()
+    };
+    let many = cs.len() > 1;
+    let tag = |what: &str, c: &Comparison, run: &str| {
+        if many {
+            format!("{what} {}", if run == "B" { &c.b } else { &c.a })
+        } else {
+            what.to_string()
+        }
+    };
+    for c in cs {
+        let ts = |f: &FrameRow| f.timestep as f64;
+        let line = |label: String, points: Vec<(f64, f64)>| Series { label, points, kind: SeriesKind::Line };
+        dev.series.push(line(tag("RMS", c, "A"), c.frames.iter().map(|f| (ts(f), f.pos_rms)).collect()));
+        dev.series.push(line(tag("max", c, "A"), c.frames.iter().map(|f| (ts(f), f.pos_max)).collect()));
+        ke.series.push(line(tag("A", c, "A"), c.frames.iter().map(|f| (ts(f), f.a.ke)).collect()));
+        ke.series.push(line(tag("B", c, "B"), c.frames.iter().map(|f| (ts(f), f.b.ke)).collect()));
+    }
+    let (t0, t1) = cs
+        .iter()
+        .flat_map(|c| c.frames.iter().map(|f| f.timestep as f64))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(t), b.max(t)));
+    if let (Some(c), true) = (cs.first(), t0 <= t1) {
+        let tol = c.options.tol_pos;
+        dev.series.push(Series { label: format!("tolerance {tol:e}"), points: vec![(t0, tol), (t1, tol)], kind: SeriesKind::Line });
+    }
+    vec![dev, ke]
+}
+
 fn run(args: &CompareArgs) -> Result<ExitCode> {
     if args.against.is_some() {
+        if args.plot.is_some() {
+            return Err(Error::usage("--plot works in two-run mode (demx compare A B), not with --against"));
+        }
         return super::compare_deck::run(args);
     }
     let Some(b) = &args.b else {
         return Err(Error::usage("demx compare needs two runs A B, or a deck with --against liggghts|lammps"));
     };
+    if let Some(p) = &args.plot {
+        crate::plot::check_path(p)?;
+    }
     let cs = compare_inputs(&args.a, b, &args.options())?;
+    if let Some(p) = &args.plot {
+        crate::plot::write_png(p, &charts(&cs))?;
+    }
     if !args.heap {
         return report(args, &cs, None);
     }

@@ -1,4 +1,4 @@
-//! `demx repose DUMP [--frame N] [--json]`: the angle of repose of a heap the
+//! `demx repose DUMP [--frame N] [--json] [--plot FILE.png]`: the angle of repose of a heap the
 //! way Elekes & Parteli (2021, PNAS, Fig. 1) measure it. For each side
 //! projection (x-z and y-z) the heap's upper boundary is found by
 //! rasterising the spheres (each column of the raster takes the highest
@@ -46,11 +46,45 @@ pub fn regime(bo: f64) -> &'static str {
     }
 }
 
-/// Base angle (degrees) of the isosceles triangle with the area of the
-/// upper boundary of spheres (horizontal centre `h`, height `z` above the
-/// plate, radius `r`) in one side projection, rasterised with `pixel`
-/// wide columns. None without particles.
-pub fn projection_angle(h: &[f64], z: &[f64], r: &[f64], pixel: f64) -> Option<f64> {
+/// Rasterised upper boundary of a heap in one side projection and the
+/// isosceles triangle fitted to it.
+#[derive(Clone, Debug)]
+pub struct Profile {
+    /// Horizontal coordinate of the left edge of column 0, m.
+    pub lo: f64,
+    /// Column width, m.
+    pub pixel: f64,
+    /// Height of the highest sphere surface over each column (0: empty), m.
+    pub top: Vec<f64>,
+    /// First and last column of the heap base (contiguous non-empty columns
+    /// around the crest).
+    pub base_cols: (usize, usize),
+    /// Base length B, m.
+    pub base: f64,
+    /// Area A under the boundary over the base, m^2.
+    pub area: f64,
+    /// Base angle theta = atan(4 A / B^2), degrees.
+    pub theta: f64,
+}
+
+impl Profile {
+    /// Centre of column `i`, m.
+    pub fn column_centre(&self, i: usize) -> f64 {
+        self.lo + (i as f64 + 0.5) * self.pixel
+    }
+    /// The fitted isosceles triangle: left base corner, apex, right base
+    /// corner (height 2 A / B over the base midpoint).
+    pub fn triangle(&self) -> [(f64, f64); 3] {
+        let x0 = self.lo + self.base_cols.0 as f64 * self.pixel;
+        let x1 = self.lo + (self.base_cols.1 + 1) as f64 * self.pixel;
+        [(x0, 0.0), (0.5 * (x0 + x1), 2.0 * self.area / self.base), (x1, 0.0)]
+    }
+}
+
+/// Upper boundary and fitted triangle of spheres (horizontal centre `h`,
+/// height `z` above the plate, radius `r`) in one side projection,
+/// rasterised with `pixel` wide columns. None without particles.
+pub fn projection_profile(h: &[f64], z: &[f64], r: &[f64], pixel: f64) -> Option<Profile> {
     if h.is_empty() || !(pixel > 0.0) {
         return None;
     }
@@ -86,7 +120,16 @@ pub fn projection_angle(h: &[f64], z: &[f64], r: &[f64], pixel: f64) -> Option<f
     }
     let base = (b - a + 1) as f64 * pixel;
     let area: f64 = top[a..=b].iter().sum::<f64>() * pixel;
-    Some((4.0 * area / (base * base)).atan().to_degrees())
+    let theta = (4.0 * area / (base * base)).atan().to_degrees();
+    Some(Profile { lo, pixel, top, base_cols: (a, b), base, area, theta })
+}
+
+/// Base angle (degrees) of the isosceles triangle with the area of the
+/// upper boundary of spheres (horizontal centre `h`, height `z` above the
+/// plate, radius `r`) in one side projection, rasterised with `pixel`
+/// wide columns. None without particles.
+pub fn projection_angle(h: &[f64], z: &[f64], r: &[f64], pixel: f64) -> Option<f64> {
+    projection_profile(h, z, r, pixel).map(|p| p.theta)
 }
 
 fn column(f: &Frame, names: &[&str]) -> Option<Vec<f64>> {
@@ -120,6 +163,11 @@ pub(crate) fn positions(f: &Frame) -> Result<[Vec<f64>; 3]> {
 
 /// Angle of repose of the heap in `f`; the plate is the lowest sphere bottom.
 pub fn repose(f: &Frame) -> Result<Repose> {
+    repose_profiles(f).map(|(r, _, _)| r)
+}
+
+/// [`repose`] with the x-z and y-z profiles it was computed from.
+pub fn repose_profiles(f: &Frame) -> Result<(Repose, Profile, Profile)> {
     let [x, y, z] = positions(f)?;
     let r = radii(f)?;
     if r.is_empty() {
@@ -129,13 +177,42 @@ pub fn repose(f: &Frame) -> Result<Repose> {
     let zh: Vec<f64> = z.iter().map(|v| v - plate).collect();
     let rmin = r.iter().cloned().fold(f64::INFINITY, f64::min);
     let pixel = rmin / 5.0;
-    let txz = projection_angle(&x, &zh, &r, pixel).ok_or_else(|| Error::usage("cannot rasterise the x-z projection"))?;
-    let tyz = projection_angle(&y, &zh, &r, pixel).ok_or_else(|| Error::usage("cannot rasterise the y-z projection"))?;
+    let pxz = projection_profile(&x, &zh, &r, pixel).ok_or_else(|| Error::usage("cannot rasterise the x-z projection"))?;
+    let pyz = projection_profile(&y, &zh, &r, pixel).ok_or_else(|| Error::usage("cannot rasterise the y-z projection"))?;
+    let (txz, tyz) = (pxz.theta, pyz.theta);
     let theta = 0.5 * (txz + tyz);
     let sd = (txz - tyz).abs() / std::f64::consts::SQRT_2;
     let height = zh.iter().zip(&r).map(|(a, b)| a + b).fold(0.0, f64::max);
     let diameter = 2.0 * r.iter().sum::<f64>() / r.len() as f64;
-    Ok(Repose { theta_xz: txz, theta_yz: tyz, theta, sd, height, particles: r.len(), diameter })
+    let rep = Repose { theta_xz: txz, theta_yz: tyz, theta, sd, height, particles: r.len(), diameter };
+    Ok((rep, pxz, pyz))
+}
+
+/// The `--plot` charts: each side projection with its rasterised upper
+/// boundary and fitted triangle, equal scales.
+pub fn charts(xz: &Profile, yz: &Profile) -> Vec<crate::plot::Chart> {
+    use crate::plot::{Chart, Series, SeriesKind};
+    [("x", xz), ("y", yz)]
+        .into_iter()
+        .map(|(axis, p)| {
+            let boundary = (0..p.top.len()).map(|i| (p.column_centre(i), p.top[i])).collect();
+            Chart {
+                title: format!("{axis}-z projection: theta = {:.2} deg", p.theta),
+                x_label: format!("{axis} (m)"),
+                y_label: "height over the plate (m)".into(),
+                equal_aspect: true,
+                series: vec![
+                    Series { label: "upper boundary".into(), points: boundary, kind: SeriesKind::Line },
+                    Series {
+                        label: format!("triangle, same area (B = {:.3e} m)", p.base),
+                        points: p.triangle().to_vec(),
+                        kind: SeriesKind::Polygon,
+                    },
+                ],
+                ..Chart::default()
+            }
+        })
+        .collect()
 }
 
 /// Pick frame `index` (negative: from the end; default the last) of a dump.
@@ -198,13 +275,43 @@ impl HeapCli {
     }
 }
 
+/// Arguments of `demx repose`: the heap arguments and `--plot`.
+#[derive(clap::Parser, Debug)]
+pub struct ReposeCli {
+    /// Dump, frame and Bond number settings.
+    #[command(flatten)]
+    pub heap: HeapCli,
+    /// Draw both side projections with their upper boundary and fitted
+    /// triangle into this PNG file.
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<std::path::PathBuf>,
+}
+
 /// Entry point: `args` are the words after the subcommand name.
 pub fn cli(args: Vec<String>) -> ExitCode {
-    let c = match HeapCli::parse("demx repose", "Angle of repose of a heap (Elekes & Parteli 2021)", args) {
-        Ok(c) => c,
-        Err(code) => return code,
+    use clap::{CommandFactory, FromArgMatches};
+    let name = "demx repose";
+    let cmd = ReposeCli::command().name(name).about("Angle of repose of a heap (Elekes & Parteli 2021)");
+    let parsed = cmd.try_get_matches_from(std::iter::once(name.to_string()).chain(args)).and_then(|m| ReposeCli::from_arg_matches(&m));
+    let (c, plot) = match parsed {
+        Ok(r) => (r.heap, r.plot),
+        Err(e) => {
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+        }
     };
-    let res = pick_frame(&c.dump, c.frame).and_then(|f| repose(&f));
+    if let Some(p) = &plot {
+        if let Err(e) = crate::plot::check_path(p) {
+            eprintln!("error: {}", e.message());
+            return ExitCode::from(e.exit_code());
+        }
+    }
+    let res = pick_frame(&c.dump, c.frame).and_then(|f| repose_profiles(&f)).and_then(|(r, xz, yz)| {
+        if let Some(p) = &plot {
+            crate::plot::write_png(p, &charts(&xz, &yz))?;
+        }
+        Ok(r)
+    });
     match res {
         Ok(r) => {
             let bo = bond_number(c.gamma, r.diameter, c.g, c.rho);

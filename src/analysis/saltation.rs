@@ -4,7 +4,7 @@
 //! flux Q-hat (Eq. 9) and the Shields number Theta (Eq. 10). Writes CSV.
 //!
 //! Usage: `demx saltation [--ustar U] [--rho-p 2650] [--rho-f 1.225] [--dm 200e-6]
-//! [--g 9.81] [--from T] [--dt DT] [--group-type T] [-o out.csv] DUMP...`
+//! [--g 9.81] [--from T] [--dt DT] [--group-type T] [-o out.csv] [--plot FILE.png] DUMP...`
 //! Dumps need `id type vx` (or `vy` with `--dir y`) and `mass`, or `radius`
 //! (mass from `--rho-p`); the time of a frame is `ITEM: TIME` or step*dt.
 
@@ -106,10 +106,16 @@ pub fn flux_series(paths: &[String], s: &Settings) -> Result<Vec<Row>> {
     Ok(out)
 }
 
-fn parse(args: &[String]) -> Result<(Settings, Vec<String>, Option<String>)> {
+/// Command-line options besides the [`Settings`].
+struct Outputs {
+    csv: Option<String>,
+    plot: Option<std::path::PathBuf>,
+}
+
+fn parse(args: &[String]) -> Result<(Settings, Vec<String>, Outputs)> {
     let mut s = Settings::default();
     let mut files = vec![];
-    let mut out = None;
+    let mut out = Outputs { csv: None, plot: None };
     let mut i = 0;
     let num = |i: usize| -> Result<f64> {
         let v = args.get(i).ok_or_else(|| Error::usage(format!("{} needs a value", args[i - 1])))?;
@@ -132,7 +138,8 @@ fn parse(args: &[String]) -> Result<(Settings, Vec<String>, Option<String>)> {
                     _ => return Err(Error::usage("--dir needs x or y")),
                 }
             }
-            "-o" | "--output" => out = Some(args.get(i + 1).ok_or_else(|| Error::usage("-o needs a file"))?.clone()),
+            "-o" | "--output" => out.csv = Some(args.get(i + 1).ok_or_else(|| Error::usage("-o needs a file"))?.clone()),
+            "--plot" => out.plot = Some(args.get(i + 1).ok_or_else(|| Error::usage("--plot needs a file"))?.into()),
             "-h" | "--help" => return Err(Error::usage(HELP)),
             a if a.starts_with('-') => return Err(Error::usage(format!("unknown option {a}\n{HELP}"))),
             _ => {
@@ -149,11 +156,14 @@ fn parse(args: &[String]) -> Result<(Settings, Vec<String>, Option<String>)> {
     Ok((s, files, out))
 }
 
-const HELP: &str = "usage: demx saltation [--ustar U] [--rho-p 2650] [--rho-f 1.225] [--dm 200e-6] [--g 9.81] [--from T] [--dt DT] [--group-type T] [--dir x|y] [-o out.csv] DUMP...";
+const HELP: &str = "usage: demx saltation [--ustar U] [--rho-p 2650] [--rho-f 1.225] [--dm 200e-6] [--g 9.81] [--from T] [--dt DT] [--group-type T] [--dir x|y] [-o out.csv] [--plot FILE.png] DUMP...";
 
 /// Run the analysis and write the CSV (time series, then a summary row).
 pub fn run(args: &[String]) -> Result<String> {
     let (s, files, out) = parse(args)?;
+    if let Some(p) = &out.plot {
+        crate::plot::check_path(p)?;
+    }
     let rows = flux_series(&files, &s)?;
     let mut csv = String::from("step,time,Q\n");
     for (st, t, q) in &rows {
@@ -170,10 +180,43 @@ pub fn run(args: &[String]) -> Result<String> {
         q_hat(mean, &s),
         theta.map_or("".into(), |t| format!("{t:.9e}"))
     );
-    if let Some(o) = out {
+    if let Some(o) = out.csv {
         std::fs::write(&o, &csv).map_err(|e| Error::usage(format!("cannot write {o}: {e}")))?;
     }
+    if let Some(p) = &out.plot {
+        crate::plot::write_png(p, &[chart(&rows, &s)])?;
+    }
     Ok(csv)
+}
+
+/// The `--plot` chart: Q of every frame against time, the running mean of Q
+/// from `--from` on, and the time-averaged Q over the averaging window.
+pub fn chart(rows: &[Row], s: &Settings) -> crate::plot::Chart {
+    use crate::plot::{Chart, Series, SeriesKind};
+    let q: Vec<(f64, f64)> = rows.iter().map(|r| (r.1, r.2)).collect();
+    let mut running = vec![];
+    let (mut sum, mut n) = (0.0, 0.0);
+    for r in rows.iter().filter(|r| r.1 >= s.from) {
+        sum += r.2;
+        n += 1.0;
+        running.push((r.1, sum / n));
+    }
+    let mut series = vec![Series { label: "Q per frame".into(), points: q, kind: SeriesKind::Line }];
+    if let (Some(first), Some(last)) = (running.first().copied(), running.last().copied()) {
+        series.push(Series { label: format!("running mean from t = {:.4}", s.from), points: running, kind: SeriesKind::Line });
+        series.push(Series {
+            label: format!("mean Q = {:.4e} (Q-hat {:.4})", last.1, q_hat(last.1, s)),
+            points: vec![(first.0, last.1), (last.0, last.1)],
+            kind: SeriesKind::Line,
+        });
+    }
+    Chart {
+        title: format!("saltation flux ({} downwind)", s.vcol.trim_start_matches('v')),
+        x_label: "time (s)".into(),
+        y_label: "Q (kg/(m s))".into(),
+        series,
+        ..Chart::default()
+    }
 }
 
 /// Entry point: `args` are the words after the subcommand name.
