@@ -135,7 +135,7 @@ pub struct Guard {
 #[derive(Clone, Debug, PartialEq)]
 enum Trip {
     /// Particle index, which quantity.
-    NonFinite(usize, &'static str),
+    NonFinite(usize, String),
     /// Pair overlap: particle indices (i, j), fraction of min radius.
     PairOverlap(usize, usize, f64),
     /// Wall overlap: particle index, fix index, fraction of radius.
@@ -246,15 +246,16 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
         // one test for the common case; the sum of finite values overflows
         // only near f64::MAX, which the travel check flags anyway
         if !(x.x + x.y + x.z + v.x + v.y + v.z + w.x + w.y + w.z).is_finite() {
-            let what = if !finite3(x) {
-                "position"
-            } else if !finite3(v) {
-                "velocity"
-            } else if !finite3(w) {
-                "angular velocity"
-            } else {
-                "velocity"
-            };
+            let mut what = String::new();
+            for (name, q) in [("position", x), ("velocity", v), ("angular velocity", w)] {
+                if !finite3(q) {
+                    what.push_str(if what.is_empty() { "" } else { " and " });
+                    what.push_str(name);
+                }
+            }
+            if what.is_empty() {
+                what.push_str("state (values near the largest float)");
+            }
             return Some(Trip::NonFinite(i, what));
         }
         let v2 = v.norm_squared();
@@ -350,7 +351,11 @@ fn g4(x: f64) -> String {
 }
 
 fn pct(f: f64) -> String {
-    format!("{:.0}%", 100.0 * f)
+    if 100.0 * f.abs() >= 10.0 || !f.is_finite() {
+        format!("{:.0}%", 100.0 * f)
+    } else {
+        format!("{}%", crate::io::cfmt::fmt_g(100.0 * f, 2))
+    }
 }
 
 /// The contacts of particle i now: (partner text, overlap fraction of i's
@@ -643,7 +648,7 @@ mod tests {
         sim.particles.v[1] = V3::new(25.1, 0.0, 0.0);
         assert!(matches!(find_trip(&sim, true), Some(Trip::Travel(1, _))));
         sim.particles.omega[0].y = f64::NAN;
-        assert_eq!(find_trip(&sim, true), Some(Trip::NonFinite(0, "angular velocity")));
+        assert_eq!(find_trip(&sim, true), Some(Trip::NonFinite(0, "angular velocity".into())));
         sim.guard.settings.speed = Some(1.0);
         sim.particles.omega[0].y = 0.0;
         sim.guard.settings.travel = None;
