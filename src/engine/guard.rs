@@ -241,7 +241,19 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
     let speed2 = g.speed.map(|s| s * s);
     let mut worst_travel: Option<(usize, f64)> = None;
     let mut worst_speed: Option<(usize, f64)> = None;
-    for i in 0..p.len() {
+    // fast pass: any particle non-finite, too fast for its radius, or too
+    // fast? (no early exits in the loop body; the detailed pass below runs
+    // only when something is flagged)
+    let t2dt = travel2.map_or(f64::INFINITY, |t2| t2 / dt2.max(f64::MIN_POSITIVE));
+    let s2 = speed2.unwrap_or(f64::INFINITY);
+    let mut flagged = false;
+    for ((x, v), (w, &r)) in p.x.iter().zip(&p.v).zip(p.omega.iter().zip(&p.radius)) {
+        let v2 = v.norm_squared();
+        let sum = x.x + x.y + x.z + v2 + w.x + w.y + w.z;
+        // v2 > (travel R / dt)^2 is |v| dt > travel R
+        flagged |= !sum.is_finite() | (v2 > t2dt * (r * r)) | (v2 > s2);
+    }
+    for i in 0..if flagged { p.len() } else { 0 } {
         let (x, v, w) = (&p.x[i], &p.v[i], &p.omega[i]);
         // one test for the common case; the sum of finite values overflows
         // only near f64::MAX, which the travel check flags anyway
@@ -261,7 +273,7 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
         let v2 = v.norm_squared();
         if let Some(t2) = travel2 {
             let r2 = p.radius[i] * p.radius[i];
-            if v2 * dt2 > t2 * r2 {
+            if r2 > 0.0 && v2 * dt2 > t2 * r2 {
                 let ratio = (v2 * dt2 / r2).sqrt();
                 if worst_travel.map_or(true, |(_, w)| ratio > w) {
                     worst_travel = Some((i, ratio));
@@ -278,19 +290,17 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
     if let Some(lim) = lim {
         let mut worst: Option<(usize, usize, f64)> = None;
         let n = p.len();
-        for k in 0..sim.pairs.len() {
-            let (a, b) = (sim.pairs.a[k] as usize, sim.pairs.b[k] as usize);
+        let pl = &sim.pairs;
+        for (k, ((&a, &b), shift)) in pl.a.iter().zip(&pl.b).zip(&pl.shift).enumerate() {
+            let (a, b) = (a as usize, b as usize);
             if a >= n || b >= n {
                 continue;
             }
             // compare squared distances; take the root only for violations
             let (ra, rb) = (p.radius[a], p.radius[b]);
             let reach = ra + rb - lim * ra.min(rb);
-            if reach <= 0.0 {
-                continue;
-            }
-            let r2 = (p.x[a] - p.x[b] - sim.pairs.shift[k]).norm_squared();
-            if r2 < reach * reach {
+            let r2 = (p.x[a] - p.x[b] - shift).norm_squared();
+            if reach > 0.0 && r2 < reach * reach {
                 let f = pair_overlap(sim, k);
                 if worst.map_or(true, |(_, _, w)| f > w) {
                     worst = Some((a, b, f));
@@ -321,9 +331,9 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
 /// Copy the state into the snapshot buffers (no allocation once they are
 /// large enough).
 fn take_snapshot(sim: &mut Sim) {
-    fn copy<T: Clone>(dst: &mut Vec<T>, src: &[T]) {
-        dst.clear();
-        dst.extend_from_slice(src);
+    fn copy<T: Copy + Default>(dst: &mut Vec<T>, src: &[T]) {
+        dst.resize(src.len(), T::default());
+        dst.copy_from_slice(src);
     }
     let p = &sim.particles;
     let s = &mut sim.guard.snap;
