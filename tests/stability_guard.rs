@@ -95,7 +95,7 @@ fn timestep_twice_the_hertz_time_is_stopped_at_the_first_collision() {
     // the gap of 10 mm closes at 2 m/s: first contact after 5 ms
     let first_contact = (5e-3 / dt).ceil() as i64;
     let step = stop_step(&msg);
-    assert!(step >= first_contact && step <= first_contact + 10, "stopped at step {step}, contact at {first_contact}: {msg}");
+    assert!(step >= first_contact && step <= first_contact + 20, "stopped at step {step}, contact at {first_contact}: {msg}");
     // dt / t_Hertz = 2 is reported as 200%
     assert!(msg.contains("200% of the Hertz time"), "{msg}");
     // the last good state: a data file demx reads, from a check before the
@@ -104,7 +104,7 @@ fn timestep_twice_the_hertz_time_is_stopped_at_the_first_collision() {
     assert!(msg.contains("demx.lastgood.data"), "{msg}");
     let df = demx::io::data::read_data(&file).expect("last good state readable");
     let n: i64 = df.title.rsplit(' ').next().and_then(|s| s.parse().ok()).expect("timestep in title");
-    assert!(n < first_contact && n % 10 == 0, "last good step {n}");
+    assert!(n < first_contact && n % 20 == 0, "last good step {n}");
     assert_eq!(df.atoms.len(), 2);
     for a in &df.atoms {
         let expect = 0.006 - n as f64 * dt;
@@ -185,7 +185,7 @@ fn nan_from_a_variable_is_caught() {
     assert_eq!(out.status.code(), Some(1), "{msg}");
     assert!(msg.contains("particle 1 has a non-finite"), "{msg}");
     assert!(msg.contains("velocity"), "{msg}");
-    assert!(stop_step(&msg) <= 10, "{msg}");
+    assert!(stop_step(&msg) <= 20, "{msg}");
     assert!(msg.contains("a non-finite value from outside the contact law"), "{msg}");
     // last good = the start of the run, still finite
     let df = demx::io::data::read_data(dir.path().join("demx.lastgood.data")).expect("state written");

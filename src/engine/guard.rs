@@ -41,10 +41,12 @@ pub const DEFAULT_OVERLAP: f64 = 0.5;
 /// steps, so travelling half a radius per step already means an overlap near
 /// a full radius; a deck whose particles do that is not resolving contacts.
 pub const DEFAULT_TRAVEL: f64 = 0.5;
-/// Default check interval (steps): a collision resolved with a time step of
-/// 10-20 % of its duration spans 5-10 steps, so a too-large time step is
-/// caught within the first collision or the ten steps after it.
-pub const DEFAULT_EVERY: i64 = 10;
+/// Default check interval (steps). A time step too large for the stiffness
+/// turns the first collision into an explosion (overlap, then a speed far
+/// above the travel limit) that the next check sees, at most 20 steps later;
+/// a resolved collision spans at least 5-10 steps. At 20 the checks cost
+/// about 1.3 % of the instructions of the settle template (2.7 % at 10).
+pub const DEFAULT_EVERY: i64 = 20;
 /// Default name of the last-good state file (current directory).
 pub const DEFAULT_FILE: &str = "demx.lastgood.data";
 /// A time step above this fraction of the Hertz or Rayleigh time is named as
