@@ -58,7 +58,19 @@ pub trait Fix: Send {
     fn integrates(&self) -> bool {
         false
     }
-    /// Extra interaction range beyond contact this fix needs from walls (0).
+    /// The deepest overlap of any particle with this fix's surfaces (walls),
+    /// as (particle index, overlap / particle radius); None when the fix has
+    /// no surfaces or nothing touches them. Read by the stability guard every
+    /// few steps, so it must not change any state.
+    fn max_surface_overlap(&self, _sim: &Sim) -> Option<(usize, f64)> {
+        None
+    }
+    /// Overlap depth (length) of particle `i` with this fix's surfaces, if
+    /// it touches one (the stability guard's diagnosis).
+    fn surface_overlap(&self, _sim: &Sim, _i: usize) -> Option<f64> {
+        None
+    }
+    /// Downcasting hook (insertion templates, gravity, ...).
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         None
     }

@@ -13,5 +13,6 @@ pub mod rng;
 pub mod insert;
 pub mod mesh_surface;
 pub mod wind;
+pub mod guard;
 
 pub use sim::{Dialect, Sim};

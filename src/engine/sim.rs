@@ -91,6 +91,8 @@ pub struct Sim {
     /// saved pair list and forces instead of recomputing them, so it continues
     /// bitwise as the uninterrupted run would have.
     pub resume: bool,
+    /// Stability guards (`demx_guard`): checks every few steps, last good state.
+    pub guard: super::guard::Guard,
 }
 
 impl Default for Sim {
@@ -124,6 +126,7 @@ impl Default for Sim {
             last_rate: 0.0,
             timing: [0.0; 4],
             resume: false,
+            guard: super::guard::Guard::default(),
         }
     }
 }
@@ -160,6 +163,11 @@ impl Sim {
         let lost: Vec<bool> = p.x.iter().map(|x| dom.outside_fixed(x) || !x.iter().all(|c| c.is_finite())).collect();
         let nlost = lost.iter().filter(|&&l| l).count();
         if nlost > 0 {
+            // particles leaving in a blow-up: the guard's diagnosis comes first
+            if let Some(e) = super::guard::on_lost(self) {
+                return Err(e);
+            }
+            let p = &mut self.particles;
             match self.thermo.lost {
                 super::output::LostPolicy::Error => {
                     let i = lost.iter().position(|&l| l).unwrap_or(0);
@@ -178,6 +186,8 @@ impl Sim {
                 }
             }
         }
+        let p = &mut self.particles;
+        let dom = self.domain.as_mut().ok_or_else(|| Error::runtime("no box"))?;
         dom.shrink_wrap(&p.x);
         let width = self.model.as_ref().map_or(0, |m| m.kernel.history_width());
         let table = self.model.as_ref().map(|m| &m.table);
@@ -252,6 +262,7 @@ impl Sim {
         if pre || self.pairs.x_built.len() != self.particles.len() {
             self.setup(vars)?;
         }
+        super::guard::check(self, true)?;
         self.output(vars, true)?;
         if self.dry {
             self.step += n;
@@ -298,6 +309,9 @@ impl Sim {
             Ok(())
         })?;
         self.each_fix(|f, s| f.end_of_step(s, vars))?;
+        if self.guard.due(self.step) {
+            super::guard::check(self, false)?;
+        }
         let tm2 = t.elapsed().as_secs_f64();
         let t = Instant::now();
         self.output(vars, false)?;

@@ -229,6 +229,7 @@ impl Session {
                 outputs::execute(self, cmd, vars)
             }
             "run" => self.run_command(cmd, vars),
+            "demx_guard" => self.guard_command(cmd),
             n if NOOP_COMMANDS.contains(&n) => {
                 if n == "newton" {
                     let a = Args::new(cmd);
@@ -285,6 +286,62 @@ impl Session {
         Ok(())
     }
 
+    /// `demx_guard off | on | [on] keyword value ...` (demx only): tune the
+    /// stability guards (engine/guard.rs). Keywords: `overlap F|off`,
+    /// `travel F|off`, `speed V|off`, `every K`, `file NAME|none`.
+    fn guard_command(&mut self, cmd: &Command) -> Result<()> {
+        const KEYWORDS: &[&str] = &["on", "off", "overlap", "travel", "speed", "every", "file"];
+        let mut a = Args::new(cmd);
+        let mut g = self.sim.guard.settings.clone();
+        if !a.more() {
+            return Err(Error::deck(a.end_span(), "demx_guard: missing setting").with_hint(format!("expected one of {}", KEYWORDS.join(", "))));
+        }
+        // a positive number, or `off`
+        fn limit(a: &mut Args, what: &str) -> Result<Option<f64>> {
+            if a.peek().map_or(false, |w| w.text == "off") {
+                a.pos += 1;
+                return Ok(None);
+            }
+            let v = a.f64(what)?;
+            if !(v > 0.0) || !v.is_finite() {
+                return Err(a.err_prev(format!("demx_guard: {what} must be a positive number or off, not {v}")));
+            }
+            Ok(Some(v))
+        }
+        while a.more() {
+            let k = a.choice("demx_guard keyword", KEYWORDS)?;
+            match k.text.as_str() {
+                "on" => g.enabled = true,
+                "off" => {
+                    if a.more() {
+                        return Err(Error::deck(a.peek().map_or(k.span, |w| w.span), "demx_guard off takes no further settings"));
+                    }
+                    g.enabled = false;
+                }
+                "overlap" => g.overlap = limit(&mut a, "overlap (fraction of the radius)")?,
+                "travel" => g.travel = limit(&mut a, "travel (fraction of the radius per step)")?,
+                "speed" => g.speed = limit(&mut a, "speed")?,
+                "every" => {
+                    let n = a.i64("every (steps)")?;
+                    if n < 1 {
+                        return Err(a.err_prev(format!("demx_guard: every must be at least 1, not {n}")));
+                    }
+                    g.every = n;
+                }
+                _ => {
+                    let w = a.word("file name")?;
+                    g.file = if w.text == "none" { None } else { Some(w.text.clone()) };
+                }
+            }
+            // tuning a check turns the guard on
+            if k.text != "off" {
+                g.enabled = true;
+            }
+        }
+        self.sim.guard.settings = g;
+        Ok(())
+    }
+
     fn run_command(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
         let mut a = Args::new(cmd);
         let n = a.i64("number of steps")?;
@@ -321,6 +378,12 @@ impl Session {
         if !self.sim.fixes.iter().any(|f| f.integrates()) && !self.check {
             self.sim.log.line("WARNING: No fixes defined, atoms won't move");
         }
+        self.sim.guard.timestep = if self.sim.guard.settings.enabled && !self.check {
+            summary::timestep_check(self)
+                .map(|t| crate::engine::guard::TimestepFractions { hertz: t.fraction_hertz, rayleigh: t.fraction_rayleigh })
+        } else {
+            None
+        };
         let r = self.sim.run(steps, vars, pre || self.schedule.len() == 1, post);
         match r {
             // in check mode a run-time failure is a fault of the deck: say where
@@ -363,7 +426,7 @@ pub const ALL_COMMANDS: &[&str] = &[
     "velocity", "delete_atoms", "displace_atoms", "pair_style", "pair_coeff", "fix", "unfix", "compute", "uncompute",
     "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump", "run", "write_restart", "read_restart",
     "write_data", "reset_timestep", "hard_particles", "soft_particles", "variable", "print", "include", "jump", "label",
-    "next", "if", "log", "echo", "quit", "mass",
+    "next", "if", "log", "echo", "quit", "mass", "demx_guard",
 ];
 
 impl Session {
