@@ -155,7 +155,7 @@ fn small_timestep_collision_passes_and_matches_the_unguarded_run() {
     let msg = stderr(&tight);
     assert_eq!(tight.status.code(), Some(1), "{msg}");
     assert!(msg.contains("particles 1 and 2 overlap"), "{msg}");
-    assert!(msg.contains("contacts of particle 1: particle 2"), "{msg}");
+    assert!(msg.contains("contacts of particle 1 (radius 0.001; overlaps as fractions of the smaller radius): particle 2 (overlap "), "{msg}");
 }
 
 #[test]
