@@ -83,7 +83,7 @@ fn positions(dump: &std::path::Path) -> Vec<(u64, [f64; 3], f64)> {
 #[test]
 fn perturb_moves_each_particle_by_the_amplitude() {
     let dir = tempfile::tempdir().unwrap();
-    let deck = "atom_style sphere\nboundary f f f\nregion b block 0 1 0 1 0 1\ncreate_box 1 b\n\
+    let deck = "units si\natom_style sphere\nboundary f f f\nregion b block 0 1 0 1 0 1\ncreate_box 1 b\n\
                 lattice sc 0.25\nregion inner block 0.1 0.9 0.1 0.9 0.1 0.9 units box\ncreate_atoms 1 region inner\nset type 1 diameter 0.1\n\
                 dump d all custom 1 dump.p id x y z radius\ndump_modify d format \"%d %.17g %.17g %.17g %.17g\"\nrun 0\n";
     std::fs::write(dir.path().join("in.p"), deck).unwrap();
