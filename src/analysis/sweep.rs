@@ -335,33 +335,14 @@ fn usage(msg: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
-/// Take the `-var NAME V...` groups out of the arguments (values run to the
-/// next word starting with '-' that is not a number).
-fn split_vars(args: Vec<String>) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut rest = vec![];
-    let mut groups = vec![];
-    let mut k = 0;
-    while k < args.len() {
-        if matches!(args[k].as_str(), "-var" | "-v" | "--var") {
-            let mut g = vec![];
-            k += 1;
-            while k < args.len() && (g.is_empty() || !args[k].starts_with('-') || args[k].parse::<f64>().is_ok()) {
-                g.push(args[k].clone());
-                k += 1;
-            }
-            groups.push(g);
-        } else {
-            rest.push(args[k].clone());
-            k += 1;
-        }
-    }
-    (rest, groups)
-}
-
 /// Parse and validate the arguments; `Err` is the exit code (help 0, bad use 2).
 pub fn parse(args: Vec<String>) -> Result<SweepCli, ExitCode> {
     use clap::{CommandFactory, FromArgMatches};
-    let (rest, vars) = split_vars(args);
+    // the same -var grouping as compare/reference/tradeoff
+    let (rest, vars) = match super::reference::extract_vars(args) {
+        Ok((rest, groups)) => (rest, groups.into_iter().map(|(n, v)| std::iter::once(n).chain(v).collect::<Vec<String>>()).collect::<Vec<_>>()),
+        Err(e) => return Err(usage(e.message())),
+    };
     let cmd = SweepCli::command().name("demx sweep").about("Angle of repose over particle size and gravity (Elekes & Parteli 2021, Eqs. 1-4)");
     let mut c = match cmd.try_get_matches_from(std::iter::once("demx sweep".to_string()).chain(rest)).and_then(|m| SweepCli::from_arg_matches(&m)) {
         Ok(c) => c,
@@ -654,14 +635,6 @@ pub fn cli(args: Vec<String>) -> ExitCode {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn split_vars_groups_values() {
-        let a: Vec<String> = ["in.heap", "-var", "Y", "1e7", "--d", "1e-3", "-v", "N", "-5", "x"].iter().map(|s| s.to_string()).collect();
-        let (rest, g) = split_vars(a);
-        assert_eq!(rest, vec!["in.heap", "--d", "1e-3"]);
-        assert_eq!(g, vec![vec!["Y".to_string(), "1e7".into()], vec!["N".to_string(), "-5".into(), "x".into()]]);
-    }
 
     #[test]
     fn seeds_are_the_primes_from_15485863() {
