@@ -35,8 +35,10 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def tradeoff(demx, deck, vary, seeds, n, extra_vars, threads):
+def tradeoff(demx, deck, vary, seeds, n, extra_vars, threads, plot=None):
     cmd = [demx, "tradeoff", deck, "--metric", "repose", "--json", "--seeds", str(seeds), "--threads", str(threads)]
+    if plot:
+        cmd += ["--plot", plot]
     for v in vary:
         cmd += ["--vary", v]
     cmd += ["-var", "model", "stock", "-var", "N", str(n)]
@@ -105,16 +107,17 @@ def main():
         y_main, y_extra, dtf = ["1e7", "1e8"], [], ["0.3", "0.1"]
     else:
         a.n = a.n or 2000
-        y_main, y_extra, dtf = ["1e7", "1e8", "1e9"], ["1e10"], ["0.3", "0.2", "0.1", "0.05"]
+        y_main, y_extra, dtf = ["1e7", "1e8", "1e9"], ["1e10", "6.3e10"], ["0.3", "0.2", "0.1", "0.05"]
 
     # 1. stiffness: the reference is the stiffest Y of the 3-seed study
-    ys = tradeoff(a.demx, deck, ["var:Y=" + ",".join(y_main)], a.seeds, a.n, [], a.threads)
+    plots = os.path.dirname(os.path.abspath(a.out))
+    ys = tradeoff(a.demx, deck, ["var:Y=" + ",".join(y_main)], a.seeds, a.n, [], a.threads, os.path.join(plots, "tradeoff_heap_Y.png"))
     stiff = None
     if y_extra:
         # one seed at the stiffest value (too expensive for more); compared with the first seed of the others
         stiff = tradeoff(a.demx, deck, ["var:Y=" + ",".join(y_extra)], 1, a.n, [], a.threads)
     # 2. time step at the softest Y (cheap), reference the smallest fraction
-    dts = tradeoff(a.demx, deck, ["var:dtfrac=" + ",".join(dtf)], a.seeds, a.n, [("Y", y_main[0])], a.threads)
+    dts = tradeoff(a.demx, deck, ["var:dtfrac=" + ",".join(dtf)], a.seeds, a.n, [("Y", y_main[0])], a.threads, os.path.join(plots, "tradeoff_heap_dt.png"))
 
     out = []
     out.append("## Heap: angle of repose vs stiffness and time step (`demx tradeoff`)\n")
@@ -130,13 +133,13 @@ def main():
     out.append(t + "\n")
     out.append(v + "\n")
     if stiff:
-        r = stiff["rows"][0]
         ref = [x for x in ys["rows"] if x["reference"]]
-        out.append(
-            f"One run at Y = {r['setting'][0][1]} Pa: θr = {fmt(r['mean'])}°, {fmt(r['wall_seconds'], 1)} s"
-            + (f" (vs {fmt(ref[0]['mean'])}° at Y = {ref[0]['setting'][0][1]} Pa, abs(Δθr) = {fmt(abs(r['mean'] - ref[0]['mean']))}°)" if ref and r["n"] else "")
-            + ".\n"
-        )
+        for r in stiff["rows"]:
+            out.append(
+                f"One run at Y = {r['setting'][0][1]} Pa: θr = {fmt(r['mean'])}°, {fmt(r['wall_seconds'], 1)} s"
+                + (f" (vs {fmt(ref[0]['mean'])} ± {fmt(ref[0]['sd'])}° at Y = {ref[0]['setting'][0][1]} Pa, abs(Δθr) = {fmt(abs(r['mean'] - ref[0]['mean']))}°)" if ref and r["n"] else "")
+                + ".\n"
+            )
     out.append(f"### Time step (Y = {y_main[0]} Pa; dt = dtfrac × Hertz time at 1 m/s; the deck's step counts follow dt)\n")
     t, v = table(dts, "dtfrac")
     out.append(t + "\n")
@@ -146,6 +149,7 @@ def main():
         "time step and step counts from its own ${Y}, so the softened run keeps the stiff time step; the deck variables "
         "are varied instead (var:Y, var:dtfrac).\n"
     )
+    out.append("Plots (error vs wall time): [stiffness](tradeoff_heap_Y.png), [time step](tradeoff_heap_dt.png).\n")
     out.append("Commands:\n\n```\n" + "\n".join(d["_command"] for d in [ys, stiff, dts] if d) + "\n```\n")
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     with open(a.out, "w") as f:

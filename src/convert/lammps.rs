@@ -472,19 +472,7 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     }
     let qsum: f64 = sizes.iter().map(|s| s.1).sum();
     let vp: f64 = sizes.iter().map(|(d, q)| q / qsum * std::f64::consts::PI / 6.0 * d * d * d).sum();
-    let n = if let Some(n) = get("particles_in_region").or(get("nparticles")) {
-        f.num(&n)
-    } else if let Some(fr) = get("volumefraction_region") {
-        f.num(&fr).and_then(|fr| f.region_volume(&region).map(|v| (fr * v / vp).floor()))
-    } else if let Some(m) = get("mass_in_region").or(get("mass")) {
-        let mp: f64 = sizes.iter().zip(&dens).map(|((d, q), rho)| q / qsum * rho * std::f64::consts::PI / 6.0 * d * d * d).sum();
-        f.num(&m).map(|m| (m / mp).floor())
-    } else {
-        None
-    };
-    let Some(n) = n else {
-        return Some(Action::Drop("number of particles to insert not known as a constant".into(), Severity::Dropped));
-    };
+    let mp: f64 = sizes.iter().zip(&dens).map(|((d, q), rho)| q / qsum * rho * std::f64::consts::PI / 6.0 * d * d * d).sum();
     let diam = if sizes.len() == 1 {
         format!("diam one {}", fmt(sizes[0].0))
     } else {
@@ -500,18 +488,313 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
         _ => None,
     }
     .unwrap_or_default();
-    let frac = if let Some(fr) = get("volumefraction_region") { fr } else { "0.25".into() };
     let seed = get("seed").unwrap_or_else(|| "12345".into());
-    ctx.note(Severity::Approx, format!("{style} mapped to fix pour ({n} particles): pour inserts batches at volume fraction {frac} as earlier ones fall out of region {region}; positions and timing differ; pour needs gravity and a block or z-cylinder region"));
-    Some(Action::Replace(vec![format!(
-        "fix {id} {group} pour {} {} {seed} region {region} {diam} dens {} {} vol {frac} 100 {vel}",
-        n,
-        ty.unwrap_or_else(|| "1".into()),
-        fmt(dlo),
-        fmt(dhi)
-    )
-    .trim_end()
-    .to_string()]))
+    let ty = ty.unwrap_or_else(|| "1".into());
+    let first_insert = ctx.inserts_seen == 0;
+    ctx.inserts_seen += 1;
+
+    // What the fix inserts at each insertion: insert/pack tops the region up
+    // to its target (LIGGGHTS `calc_ninsert_this`: target minus what is in
+    // the region already); insert/rate/region inserts a fixed total.
+    let target = if style == "insert/pack" {
+        if let Some(fr) = get("volumefraction_region") {
+            Some(PackCount::Fraction(fr))
+        } else if let Some(n) = get("particles_in_region") {
+            Some(PackCount::Particles(n))
+        } else {
+            get("mass_in_region").map(PackCount::Mass)
+        }
+    } else {
+        None
+    };
+    let every = get("insert_every");
+    let once = every.as_deref() == Some("once") || (style == "insert/pack" && every.is_none());
+    let vol_now = f.region_volume(&region);
+    // particles per insertion as a LAMMPS formula (region volume written from
+    // the region's own words, so that regions built from variables work)
+    let per_insert = |t: &PackCount| -> Option<String> {
+        let vexpr = region_volume_expr(f, &region)?;
+        Some(match t {
+            PackCount::Fraction(fr) => format!("floor({fr}*{vexpr}/{})", fmt(vp)),
+            PackCount::Particles(n) => n.clone(),
+            PackCount::Mass(m) => format!("floor({m}/{})", fmt(mp)),
+        })
+    };
+    let pair_before = ctx.all.get(..ctx.pos).unwrap_or(&[]).iter().any(|l| l.first().map(|s| s.as_str()) == Some("pair_style"));
+    if let (Some(t), true, 1, true) = (&target, once, sizes.len(), pair_before) {
+        if let Some(n) = per_insert(t) {
+            return Some(pack_once_rsa(ctx, id, &region, &n, &ty, &seed, sizes[0].0, dlo, w));
+        }
+    }
+    let constant_region = f.regions.get(&region).is_some_and(|r| r.args.iter().all(|a| !a.contains('$'))) && !id.contains('$');
+    let mut lines = Vec::new();
+    let (count, frac) = match (&target, once) {
+        (Some(t), true) if !(first_insert && constant_region) => {
+            // a top-up insertion in a loop or after other insertions: the count
+            // depends on what is in the region when the fix is defined
+            let Some(n) = per_insert(t) else {
+                return Some(Action::Drop(format!("region {region} is not a block or cylinder: its volume is unknown"), Severity::Dropped));
+            };
+            let nvar = format!("demx_{id}_nins");
+            lines.push(format!("variable {nvar} equal ({n})-count(all,{region})"));
+            let fr = match t {
+                PackCount::Fraction(fr) => fr.clone(),
+                _ => "0.3".into(),
+            };
+            // fix pour needs at least one particle to insert; a fixed name, as
+            // LAMMPS does not substitute ${..} inside $(..)
+            lines.push(format!("variable demx_npour equal 1+(v_{nvar}>1)*(v_{nvar}-1)"));
+            ("${demx_npour}".to_string(), fr)
+        }
+        (Some(t), true) => {
+            let n = match t {
+                PackCount::Fraction(fr) => f.num(fr).zip(vol_now).map(|(fr, v)| (fr * v / vp).floor()),
+                PackCount::Particles(n) => f.num(n),
+                PackCount::Mass(m) => f.num(m).map(|m| (m / mp).floor()),
+            };
+            let Some(n) = n else {
+                return Some(Action::Drop("number of particles to insert not known as a constant".into(), Severity::Dropped));
+            };
+            (fmt(n), one_batch_fraction(t, n, vp, vol_now))
+        }
+        (Some(t), false) => {
+            // refills every E steps while the fix lives: N per insertion x the
+            // insertions in the runs that follow until `unfix`
+            let n = match t {
+                PackCount::Fraction(fr) => f.num(fr).zip(vol_now).map(|(fr, v)| (fr * v / vp).floor()),
+                PackCount::Particles(n) => f.num(n),
+                PackCount::Mass(m) => f.num(m).map(|m| (m / mp).floor()),
+            };
+            let Some(n) = n else {
+                return Some(Action::Drop("number of particles per insertion not known as a constant".into(), Severity::Dropped));
+            };
+            let e = every.as_deref().and_then(|e| f.num(e)).filter(|e| *e >= 1.0);
+            let events = e.and_then(|e| insertions_until_unfix(ctx, id, e as u64));
+            let frac = match vol_now {
+                Some(v) if v > 0.0 => fmt(n * vp / v),
+                _ => "0.25".into(),
+            };
+            match events {
+                Some(k) => {
+                    ctx.note(Severity::Approx, format!("{style} refills region {region} to {n} particles every {} steps, {k} times before it is removed: fix pour of {} particles in batches of {n}; pour's own interval is the fall time through the region", every.as_deref().unwrap_or("?"), n * k as f64));
+                    (fmt(n * k as f64), frac)
+                }
+                None => {
+                    ctx.note(Severity::Approx, format!("{style} refills the region every {} steps, but the runs it stays active for are not constant: fix pour of one batch ({n} particles)", every.as_deref().unwrap_or("?")));
+                    (fmt(n), frac)
+                }
+            }
+        }
+        (None, _) => {
+            let n = get("nparticles").and_then(|n| f.num(&n)).or_else(|| get("mass").and_then(|m| f.num(&m)).map(|m| (m / mp).floor()));
+            let Some(n) = n else {
+                return Some(Action::Drop("number of particles to insert not known as a constant".into(), Severity::Dropped));
+            };
+            (fmt(n), "0.25".into())
+        }
+    };
+    // the count of inserted particles, for later `f_ID[1]` references
+    let referenced = ctx.all.get(ctx.pos + 1..).unwrap_or(&[]).iter().any(|l| l.iter().any(|x| x.contains(&format!("f_{id}"))));
+    if referenced && ctx.insert_counts.values().all(|v| v != &format!("demx_{id}_n")) {
+        let n0 = format!("demx_{id}_n0");
+        lines.push(format!("variable {n0} equal $(count(all))"));
+        lines.push(format!("variable demx_{id}_n equal count(all)-v_{n0}"));
+        ctx.insert_counts.insert(id.clone(), format!("demx_{id}_n"));
+    }
+    let (vx, vy, vz) = match w.iter().position(|x| x == "vel") {
+        Some(i) if w.get(i + 1).map(|s| s.as_str()) == Some("constant") && w.len() >= i + 5 => (w[i + 2].clone(), w[i + 3].clone(), w[i + 4].clone()),
+        _ => ("0".into(), "0".into(), "0".into()),
+    };
+    if once {
+        // fix pour starts each particle with the speed of a fall from the top
+        // of its region; LIGGGHTS gives the `vel` of the deck: set it after
+        // the insertion step (the particles the next run's first step adds)
+        lines.push("group demx_old empty".into());
+        lines.push("group demx_old clear".into());
+        lines.push("group demx_old union all".into());
+        ctx.after_run = vec![
+            "group demx_new empty".into(),
+            "group demx_new clear".into(),
+            "group demx_new subtract all demx_old".into(),
+            format!("velocity demx_new set {vx} {vy} {vz} units box"),
+        ];
+        ctx.note(Severity::Approx, format!("{style} mapped to fix pour: positions differ; the new particles get the deck's velocity after the first step of the next run (pour gives them the speed of a fall from the top of region {region}); pour needs gravity and a block or z-cylinder region"));
+    } else {
+        ctx.note(Severity::Approx, format!("{style} mapped to fix pour: positions differ, and pour starts each particle with the speed of a fall from the top of region {region} (LIGGGHTS: the given velocity); pour needs gravity and a block or z-cylinder region"));
+    }
+    lines.push(
+        format!("fix {id} {group} pour {count} {ty} {seed} region {region} {diam} dens {} {} vol {frac} 100 {vel}", fmt(dlo), fmt(dhi))
+            .trim_end()
+            .to_string(),
+    );
+    Some(Action::Replace(lines))
+}
+
+/// `insert/pack ... insert_every once` of one sphere size -> a random
+/// sequential packing with LAMMPS commands: `create_atoms random` of the
+/// missing number in the region (shrunk by the radius for `all_in yes`),
+/// `delete_atoms overlap` of the candidates that touch anything, repeated
+/// until the count is reached (LAMMPS 29Sep2021 `create_atoms` has no
+/// overlap check, and fix pour cannot fill a region densely: it stacks its
+/// particles toward the top). The particles exist at once (LIGGGHTS: on the
+/// next step) with the deck's velocity.
+fn pack_once_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &str, seed: &str, diam: f64, dens: f64, w: &[String]) -> Action {
+    let f = ctx.facts;
+    let k = ctx.inserts_seen;
+    let get = |key: &str| w.iter().position(|x| x == key).and_then(|i| w.get(i + 1)).cloned();
+    let (vx, vy, vz) = match w.iter().position(|x| x == "vel") {
+        Some(i) if w.get(i + 1).map(|s| s.as_str()) == Some("constant") && w.len() >= i + 5 => (w[i + 2].clone(), w[i + 3].clone(), w[i + 4].clone()),
+        _ => ("0".into(), "0".into(), "0".into()),
+    };
+    let r = diam / 2.0;
+    let mut lines = vec![format!("# demx: {id} = insert/pack once -> random sequential packing (create_atoms random + delete_atoms overlap)")];
+    // the region the centres go in: shrunk by r for all_in yes (box units only)
+    let mut target_region = region.to_string();
+    if get("all_in").as_deref() == Some("yes") {
+        if let Some(rd) = f.regions.get(region).filter(|rd| rd.args.windows(2).any(|p| p[0] == "units" && p[1] == "box")) {
+            let sh = fmt(r);
+            let b: Option<Vec<String>> = match rd.style.as_str() {
+                "block" if rd.args.len() >= 6 => Some((0..6).map(|i| format!("({}){}{sh}", rd.args[i], if i % 2 == 0 { "+" } else { "-" })).collect()),
+                "cylinder" if rd.args.len() >= 6 => Some(vec![
+                    rd.args[0].clone(),
+                    format!("({})", rd.args[1]),
+                    format!("({})", rd.args[2]),
+                    format!("({})-{sh}", rd.args[3]),
+                    format!("({})+{sh}", rd.args[4]),
+                    format!("({})-{sh}", rd.args[5]),
+                ]),
+                _ => None,
+            };
+            if let Some(b) = b.filter(|b| b.iter().all(|x| !x.contains("INF") && !x.contains("EDGE"))) {
+                let first = usize::from(rd.style == "cylinder");
+                let mut words = Vec::new();
+                for (i, x) in b.iter().enumerate() {
+                    if i < first {
+                        words.push(x.clone());
+                    } else {
+                        lines.push(format!("variable demx_b{i} equal {x}"));
+                        words.push(format!("${{demx_b{i}}}"));
+                    }
+                }
+                // named after the region, so that a region re-made in a loop (`col${k}`) gets a fresh one
+                target_region = format!("demx_in{k}_{region}");
+                lines.push(format!("region {target_region} {} {} units box", rd.style, words.join(" ")));
+            }
+        }
+    }
+    let (top, end) = (format!("demx_rsa{k}"), format!("demx_rsa{k}_end"));
+    lines.extend([
+        "group demx_old empty".to_string(),
+        "group demx_old clear".into(),
+        "group demx_old union all".into(),
+        format!("variable demx_nins equal ({per_insert})-count(all,{region})"),
+        "variable demx_T equal $(count(all)+v_demx_nins)".into(),
+        "variable demx_step0 equal $(step)".into(),
+        "variable demx_r loop 1000".into(),
+        format!("label {top}"),
+        "variable demx_left equal v_demx_T-count(all)".into(),
+        format!("if \"${{demx_left}} <= 0\" then \"jump SELF {end}\""),
+        "group demx_pre empty".into(),
+        "group demx_pre clear".into(),
+        "group demx_pre union all".into(),
+        format!("variable demx_seed equal {seed}+v_demx_r"),
+        format!("create_atoms {ty} random ${{demx_left}} ${{demx_seed}} {target_region}"),
+        "group demx_cand empty".into(),
+        "group demx_cand clear".into(),
+        "group demx_cand subtract all demx_pre".into(),
+        format!("set group demx_cand diameter {}", fmt(diam)),
+        format!("set group demx_cand density {}", fmt(dens)),
+        // LAMMPS 29Sep2021 reuses delete_atoms' neighbour list within one
+        // time step (observed: the second pass misses overlaps): step on
+        "reset_timestep $(step+1)".into(),
+        format!("delete_atoms overlap {} demx_cand all compress yes", fmt(diam)),
+        "next demx_r".into(),
+        format!("jump SELF {top}"),
+        format!("label {end}"),
+        "variable demx_r delete".into(),
+        "reset_timestep ${demx_step0}".into(),
+        "group demx_new empty".into(),
+        "group demx_new clear".into(),
+        "group demx_new subtract all demx_old".into(),
+        format!("velocity demx_new set {vx} {vy} {vz} units box"),
+    ]);
+    let referenced = ctx.all.get(ctx.pos + 1..).unwrap_or(&[]).iter().any(|l| l.iter().any(|x| x.contains(&format!("f_{id}"))));
+    if referenced {
+        lines.push(format!("variable demx_{id}_n equal $(count(demx_new))"));
+        ctx.insert_counts.insert(id.to_string(), format!("demx_{id}_n"));
+    }
+    ctx.dropped_fixes.insert(id.to_string());
+    ctx.note(
+        Severity::Approx,
+        format!("insert/pack once -> create_atoms random + delete_atoms overlap until the count is reached: positions differ, particles exist at once (LIGGGHTS: on the next step), ids are compressed after each pass (delete_atoms), the loop uses `jump SELF` (run the deck with -in FILE)"),
+    );
+    Action::Replace(lines)
+}
+
+/// What an insert/pack fix fills its region to.
+enum PackCount {
+    Fraction(String),
+    Particles(String),
+    Mass(String),
+}
+
+/// fix pour's volume fraction so that one batch holds all `n` particles.
+fn one_batch_fraction(t: &PackCount, n: f64, vp: f64, vol: Option<f64>) -> String {
+    match (t, vol) {
+        (PackCount::Fraction(fr), _) => fr.clone(),
+        (_, Some(v)) if v > 0.0 => fmt((n * vp / v * 1.001).max(0.25)),
+        _ => "0.25".into(),
+    }
+}
+
+/// The region's volume as a LAMMPS formula over its own words (`${x}`
+/// substituted by LAMMPS when the line is read). Block or cylinder.
+fn region_volume_expr(f: &Facts, id: &str) -> Option<String> {
+    let r = f.regions.get(id)?;
+    let a = |i: usize| -> Option<String> {
+        let w = r.args.get(i)?;
+        (!matches!(w.as_str(), "INF" | "-INF" | "EDGE")).then(|| format!("({w})"))
+    };
+    match r.style.as_str() {
+        "block" => Some(format!("({}-{})*({}-{})*({}-{})", a(1)?, a(0)?, a(3)?, a(2)?, a(5)?, a(4)?)),
+        "cylinder" => Some(format!("PI*{}^2*abs({}-{})", a(3)?, a(5)?, a(4)?)),
+        _ => None,
+    }
+}
+
+/// How many insertions a fix inserting every `every` steps makes in the runs
+/// after the current line until `unfix ID` (or the end of the deck): the
+/// first on the step after it is defined, then every `every` steps. None if
+/// a run length is not a constant or the deck loops.
+fn insertions_until_unfix(ctx: &Ctx, id: &str, every: u64) -> Option<u64> {
+    let f = ctx.facts;
+    // absolute step at the fix (runs before it; `upto` runs go to the step)
+    let mut step = 0u64;
+    let run_end = |w: &[String], step: u64| -> Option<u64> {
+        let n = f.num(w.get(1)?)?;
+        if n < 0.0 {
+            return None;
+        }
+        Some(if w.iter().any(|x| x == "upto") { (n as u64).max(step) } else { step + n as u64 })
+    };
+    for w in &ctx.all[..ctx.pos] {
+        match w.first().map(|s| s.as_str()) {
+            Some("run") => step = run_end(w, step)?,
+            Some("jump" | "label" | "next" | "include") => return None,
+            _ => {}
+        }
+    }
+    let start = step;
+    for w in &ctx.all[ctx.pos + 1..] {
+        match w.first().map(|s| s.as_str()) {
+            Some("run") => step = run_end(w, step)?,
+            Some("unfix") if w.get(1).map(|s| s.as_str()) == Some(id) => break,
+            Some("jump" | "label" | "next" | "include") => return None,
+            _ => {}
+        }
+    }
+    let steps = step - start;
+    (steps >= 1).then(|| (steps - 1) / every + 1)
 }
 
 /// Material values to LIGGGHTS property/global lines from LAMMPS pair

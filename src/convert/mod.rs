@@ -108,11 +108,30 @@ pub struct Ctx<'a> {
     pair_dropped: bool,
     granular: bool,
     liggghts_walls: Option<(String, String)>,
+    /// Words of every logical line of the deck, and the index of the line
+    /// being converted (rules that need the commands that follow, e.g. the
+    /// runs an insertion fix stays active for).
+    pub all: &'a [Vec<String>],
+    /// Index in `all` of the line being converted.
+    pub pos: usize,
+    /// Insertion fixes turned into `fix pour`: fix ID -> the LAMMPS
+    /// variable that stands for their `f_ID[1]` (particles inserted).
+    pub insert_counts: HashMap<String, String>,
+    /// Insertion fixes converted so far.
+    pub inserts_seen: usize,
+    /// Lines to emit after the next `run` (e.g. the velocity of particles a
+    /// converted insertion put in on that run's first step).
+    pub after_run: Vec<String>,
 }
 
 impl<'a> Ctx<'a> {
-    fn new(facts: &'a Facts) -> Ctx<'a> {
+    fn new(facts: &'a Facts, all: &'a [Vec<String>]) -> Ctx<'a> {
         Ctx {
+            all,
+            pos: 0,
+            insert_counts: HashMap::new(),
+            inserts_seen: 0,
+            after_run: Vec::new(),
             facts,
             notes: Vec::new(),
             used_seeds: HashSet::new(),
@@ -210,14 +229,60 @@ fn refs_dropped(ctx: &Ctx, word: &str) -> bool {
     word.strip_prefix("f_").map(|r| r.split('[').next().unwrap_or(r)).is_some_and(|id| ctx.dropped_fixes.contains(id) || !ctx.facts.fix_ids.contains(id))
 }
 
+/// `f_ID[1]` of an insertion fix that became `fix pour` (which has no
+/// output) -> the variable counting the particles it inserted.
+fn rewrite_insert_refs(ctx: &mut Ctx, w: &[String]) -> Option<Vec<String>> {
+    if ctx.insert_counts.is_empty() || w[0] == "fix" {
+        return None;
+    }
+    let mut hit = false;
+    let out: Vec<String> = w
+        .iter()
+        .map(|x| {
+            let mut x = x.clone();
+            for (id, var) in &ctx.insert_counts {
+                for pat in [format!("f_{id}[1]"), format!("f_{id}")] {
+                    if x.contains(&pat) && !x.contains(&format!("f_{id}[2]")) {
+                        x = x.replace(&pat, &format!("v_{var}"));
+                        hit = true;
+                    }
+                }
+            }
+            x
+        })
+        .collect();
+    if hit {
+        ctx.note(Severity::Approx, "f_ID[1] of the insertion fix (particles inserted) -> a count of atoms since the fix was defined (fix pour has no output; lost atoms count against it)".into());
+    }
+    hit.then_some(out)
+}
+
 /// 3.x -> LAMMPS rules for one command.
 fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
+    if let Some(v) = rewrite_insert_refs(ctx, w) {
+        return match lammps_rules(ctx, &v) {
+            Action::Keep => Action::Replace(vec![v.join(" ")]),
+            a => a,
+        };
+    }
     let r = match w[0].as_str() {
         "atom_style" if w.get(1).map(|s| s.as_str()) == Some("granular") => Some(Action::Replace(vec![if ctx.facts.has_adapt { "atom_style sphere 1".into() } else { "atom_style sphere".into() }])),
         "atom_modify" if ctx.facts.has_insertion && w.windows(2).any(|p| p[0] == "map" && p[1] == "array") => {
             ctx.note(Severity::Info, "atom_modify map array -> map hash: LAMMPS 29Sep2021 fix pour segfaults in Atom::map_set with map array (observed)".into());
             Some(Action::Replace(vec![w.iter().map(|x| if x == "array" { "hash" } else { x.as_str() }).collect::<Vec<_>>().join(" ")]))
         }
+        "run" if !ctx.after_run.is_empty() => {
+            let mut v = vec![w.join(" ")];
+            v.append(&mut ctx.after_run);
+            Some(Action::Replace(v))
+        }
+        // LIGGGHTS (old LAMMPS) takes the whole-line format string
+        "dump_modify" if w.get(2).map(|s| s.as_str()) == Some("format") && w.get(3).is_some_and(|x| !matches!(x.as_str(), "line" | "int" | "float" | "none")) => {
+            let mut v = w.to_vec();
+            v.insert(3, "line".into());
+            Some(Action::Replace(vec![v.join(" ")]))
+        }
+        "hard_particles" | "soft_particles" => Some(Action::Drop(format!("{}: a LIGGGHTS switch for large overlaps; LAMMPS has none", w[0]), Severity::Info)),
         "communicate" => {
             if w.windows(2).any(|p| p[0] == "vel" && p[1] == "yes") {
                 Some(Action::Replace(vec!["comm_modify vel yes".into()]))
@@ -327,7 +392,8 @@ enum Item {
 pub fn convert(src: &str, to: Target) -> Converted {
     let lines = logical_lines(src);
     let facts = Facts::gather(&lines);
-    let mut ctx = Ctx::new(&facts);
+    let all: Vec<Vec<String>> = lines.iter().map(|l| l.words()).collect();
+    let mut ctx = Ctx::new(&facts, &all);
     // seeds already valid in the deck are reserved
     for lg in &lines {
         for x in lg.words() {
@@ -341,7 +407,8 @@ pub fn convert(src: &str, to: Target) -> Converted {
     let coeffs: Vec<Vec<String>> = lines.iter().map(|l| l.words()).filter(|w| w.first().map(|s| s.as_str()) == Some("pair_coeff")).collect();
     let mut out = String::new();
     let mut notes = Vec::new();
-    for lg in &lines {
+    for (pos, lg) in lines.iter().enumerate() {
+        ctx.pos = pos;
         let w = lg.words();
         let mut items = Vec::new();
         if w.is_empty() {

@@ -252,6 +252,14 @@ impl PairList {
         self.builds += 1;
     }
 
+    /// Atom ids were renumbered (`delete_atoms ... compress yes`; `new_id`
+    /// holds the ids that changed): carry the history keys over.
+    pub fn retag(&mut self, new_id: &HashMap<i64, i64>) {
+        let map = |t: i64| new_id.get(&t).copied().unwrap_or(t);
+        for k in &mut self.keys {
+            *k = (map(k.0), map(k.1));
+        }
+    }
     /// Forget all pairs and history (after particles were reordered or removed
     /// the list must be rebuilt before use; history is kept by id).
     pub fn invalidate(&mut self) {

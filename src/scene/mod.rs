@@ -225,7 +225,7 @@ impl Session {
             "write_data" | "write_restart" | "read_restart" | "read_data" | "restart" => restart::execute(self, cmd, vars),
             "pair_style" | "pair_coeff" => model::execute(self, cmd),
             "fix" | "unfix" => self.fix_command(cmd, vars),
-            "thermo" | "thermo_style" | "thermo_modify" | "dump" | "dump_modify" | "undump" | "compute" | "uncompute" => {
+            "thermo" | "thermo_style" | "thermo_modify" | "dump" | "write_dump" | "dump_modify" | "undump" | "compute" | "uncompute" => {
                 outputs::execute(self, cmd, vars)
             }
             "run" => self.run_command(cmd, vars),
@@ -424,7 +424,7 @@ pub const ALL_COMMANDS: &[&str] = &[
     "compute_modify", "boundary", "dimension", "newton", "communicate", "comm_modify", "processors",
     "neighbor", "neigh_modify", "timestep", "region", "create_box", "lattice", "create_atoms", "read_data", "group", "set",
     "velocity", "delete_atoms", "displace_atoms", "pair_style", "pair_coeff", "fix", "unfix", "compute", "uncompute",
-    "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump", "run", "write_restart", "read_restart",
+    "thermo", "thermo_style", "thermo_modify", "dump", "write_dump", "dump_modify", "undump", "run", "write_restart", "read_restart",
     "write_data", "reset_timestep", "hard_particles", "soft_particles", "variable", "print", "include", "jump", "label",
     "next", "if", "log", "echo", "quit", "mass", "demx_guard",
 ];

@@ -101,6 +101,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             Ok(())
         }
         "dump" => dump_command(s, cmd, &mut a),
+        "write_dump" => write_dump(s, cmd),
         "dump_modify" => {
             let w = a.word("dump id")?;
             let k = s.sim.dumps.iter().position(|d| d.id() == w.text).ok_or_else(|| Error::deck(w.span, format!("dump_modify: dump '{}' does not exist", w.text)))?;
@@ -420,6 +421,37 @@ fn column_values(sim: &Sim, c: &str) -> Result<Vec<f64>> {
         return sim.peratom('c', id, col).map_err(|e| Error::runtime(format!("dump column {c}: {e}")));
     }
     sim.atom_vector(c).map_err(|e| Error::runtime(format!("dump column {c}: {e}")))
+}
+
+/// `write_dump group style file columns... [modify args...]`: one frame now,
+/// written by a one-off dump of the same style (LAMMPS semantics).
+fn write_dump(s: &mut Session, cmd: &Command) -> Result<()> {
+    let w = &cmd.words;
+    if w.len() < 4 {
+        return Err(Error::deck(cmd.span, "write_dump: expected `write_dump group style file ...`"));
+    }
+    let (cols, modify) = match w.iter().position(|x| x.text == "modify") {
+        Some(k) => (&w[4..k], &w[k + 1..]),
+        None => (&w[4..], &w[w.len()..]),
+    };
+    let word = |text: &str, at: &crate::script::Word| crate::script::Word { text: text.to_string(), span: at.span, quoted: false };
+    // dump demx_write_dump GROUP STYLE 0 FILE COLUMNS...
+    let mut words = vec![word("dump", &w[0]), word("demx_write_dump", &w[0]), w[1].clone(), w[2].clone(), word("0", &w[2]), w[3].clone()];
+    words.extend(cols.iter().cloned());
+    let dump_cmd = Command { words, span: cmd.span };
+    let mut a = Args::new(&dump_cmd);
+    dump_command(s, &dump_cmd, &mut a)?;
+    let Some(k) = s.sim.dumps.iter().position(|x| x.id() == "demx_write_dump") else {
+        return Ok(());
+    };
+    let mut d = s.sim.dumps.remove(k);
+    if !modify.is_empty() {
+        d.modify(modify)?;
+    }
+    if !s.check {
+        d.write(&s.sim)?;
+    }
+    Ok(())
 }
 
 fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {

@@ -453,6 +453,11 @@ fn group_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             }
         }
         "empty" => {}
+        "clear" => {
+            for m in &mut s.sim.particles.mask {
+                *m &= !bit;
+            }
+        }
         "subtract" | "union" | "intersect" => {
             let mut bits = vec![];
             for w in a.rest() {
@@ -469,7 +474,7 @@ fn group_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             }
         }
         "dynamic" | "static" | "include" | "variable" => return Err(Error::unsupported(style.span, format!("group {}", style.text))),
-        _ => return Err(bad_keyword(style, "group style", &["type", "id", "region", "empty", "subtract", "union", "intersect", "delete"])),
+        _ => return Err(bad_keyword(style, "group style", &["type", "id", "region", "empty", "clear", "subtract", "union", "intersect", "delete"])),
     }
     let _ = cmd;
     let p = &mut s.sim.particles;
@@ -659,12 +664,82 @@ fn delete_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             let r = region(s, w)?;
             (0..p.len()).map(|i| r.contains(p.x[i])).collect()
         }
+        "overlap" => {
+            let cut = super::args::parse_f64(w)?;
+            if cut <= 0.0 {
+                return Err(Error::deck(w.span, "delete_atoms overlap: the cutoff must be positive"));
+            }
+            let (g1, g2) = (s.group(a.word("group1")?)?, s.group(a.word("group2")?)?);
+            overlap_victims(&s.sim.particles, cut, g1, g2)
+        }
         _ => return Err(Error::unsupported(style.span, format!("delete_atoms {}", style.text))),
     };
+    let mut compress = true;
+    while a.more() {
+        let k = a.choice("keyword", &["compress", "bond", "mol"])?;
+        let on = a.yes_no(&k.text)?;
+        if k.text == "compress" {
+            compress = on;
+        } else if on {
+            return Err(Error::unsupported(k.span, format!("delete_atoms {} yes (no molecules in granular decks)", k.text)));
+        }
+    }
     let n = s.sim.particles.remove_where(&remove);
     s.sim.log.line(&format!("Deleted {n} atoms, new total = {}", s.sim.particles.len()));
+    if compress {
+        // LAMMPS/LIGGGHTS default: ids renumbered 1..N in id order
+        let p = &mut s.sim.particles;
+        let mut order: Vec<usize> = (0..p.len()).collect();
+        order.sort_by_key(|&i| p.tag[i]);
+        let mut map = std::collections::HashMap::new();
+        for (rank, &i) in order.iter().enumerate() {
+            let new = rank as i64 + 1;
+            if p.tag[i] != new {
+                map.insert(p.tag[i], new);
+                p.tag[i] = new;
+            }
+        }
+        if !map.is_empty() {
+            s.sim.pairs.retag(&map);
+        }
+    }
     s.sim.force_rebuild = true;
     Ok(())
+}
+
+/// `delete_atoms overlap CUT G1 G2` (LAMMPS semantics): an atom of G1 goes
+/// if an atom of G2 not already deleted lies closer than CUT; of a pair in
+/// both groups only one goes. Atoms are visited in id order (LAMMPS: in
+/// storage order), so the outcome does not depend on storage.
+fn overlap_victims(p: &crate::engine::particles::Particles, cut: f64, g1: u32, g2: u32) -> Vec<bool> {
+    use std::collections::HashMap;
+    let n = p.len();
+    let cell = |x: &crate::physics::V3| -> (i64, i64, i64) { ((x.x / cut).floor() as i64, (x.y / cut).floor() as i64, (x.z / cut).floor() as i64) };
+    let mut bins: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
+    for i in 0..n {
+        if p.mask[i] & g2 != 0 {
+            bins.entry(cell(&p.x[i])).or_default().push(i);
+        }
+    }
+    let mut order: Vec<usize> = (0..n).filter(|&i| p.mask[i] & g1 != 0).collect();
+    order.sort_by_key(|&i| p.tag[i]);
+    let mut gone = vec![false; n];
+    for i in order {
+        let c = cell(&p.x[i]);
+        'search: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for &j in bins.get(&(c.0 + dx, c.1 + dy, c.2 + dz)).map(|v| v.as_slice()).unwrap_or(&[]) {
+                        if j != i && !gone[j] && (p.x[i] - p.x[j]).norm() < cut {
+                            gone[i] = true;
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    gone
 }
 
 /// Fix styles of LIGGGHTS 3.8 and LAMMPS that demx knows by name but does not
