@@ -309,6 +309,11 @@ fn normal_arity(name: &str) -> Option<usize> {
 ///   (the pair value is `8 G* = 2 E / ((2 - nu)(1 + nu))`).
 ///
 /// Every particle type meets the wall with the same coefficients.
+///
+/// Known differences from lmp, not reproduced: a DMT wall contact that
+/// attracts (F_ne < 0) and slides is capped by lmp at mu (|F_ne| - ~2.5e-8 N)
+/// (constant offset, independent of E, gamma, mass, k_t; demx caps at
+/// mu |F_ne| as for pairs); a sphere leaving a JKR wall turns into NaN in lmp.
 pub fn granular_coeffs(s: &mut Session, cmd: &Command, a: &mut Args, style: &Word) -> Result<(PairSpec, ParamTable)> {
     let rest = a.rest();
     let end = rest.iter().position(|w| GRANULAR_WALL_STYLES.contains(&w.text.as_str())).ok_or_else(|| {
