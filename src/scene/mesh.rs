@@ -620,6 +620,7 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
     s.set_dialect(Dialect::Lammps);
     let first = a.word("wall style")?;
     let mut spec = PairSpec::new(cmd.span, true);
+    let mut granular_table = None;
     match first.text.as_str() {
         "hooke" | "hooke/history" | "hertz/history" => {
             let kn = a.f64("Kn")?;
@@ -642,7 +643,15 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
             spec.normal = if first.text == "hertz/history" { NormalSpec::GranHertz } else { NormalSpec::GranHooke };
             spec.tangential = if first.text == "hooke" { TangentialSpec::GranNoHistory } else { TangentialSpec::GranHistory };
         }
-        "granular" => return Err(Error::unsupported(first.span, "fix wall/gran/region granular")),
+        "granular" => {
+            // the coefficient block as for `fix wall/gran granular`, up to `region`
+            let (gspec, table) = super::walls::granular_coeffs(s, cmd, a, first)?;
+            if matches!(gspec.normal, NormalSpec::GranularCohesive(model::CohesiveNormal::Jkr, _)) {
+                return Err(Error::unsupported(first.span, "fix wall/gran/region granular jkr (contacts beyond touching at region walls)"));
+            }
+            granular_table = Some(table);
+            spec = gspec;
+        }
         _ => return Err(args::bad_keyword(first, "wall/gran/region style", &["hooke", "hooke/history", "hertz/history", "granular"])),
     }
     a.choice("keyword", &["region"])?;
@@ -655,7 +664,10 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
         }
     }
     spec.has_coeff = true;
-    let table = model::fill_table(s, &spec, cmd.span)?;
+    let table = match granular_table {
+        Some(t) => t,
+        None => model::fill_table(s, &spec, cmd.span)?,
+    };
     let kernel = model::build_kernel(&spec)?;
     let width = kernel.history_width();
     let summary = format!("wall/gran/region {id} (region {}): {}", rw.text, spec.summary());

@@ -11,6 +11,8 @@ use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
 use crate::geom::{PrimitiveWall, WallMotion};
+use crate::physics::normal::granular::{GranularDamping, GranularNormal};
+use crate::physics::normal::jkr::jkr_pulloff_overlap;
 use crate::physics::{Contact, V3};
 use crate::script::{Command, Variables, Word};
 
@@ -32,6 +34,10 @@ pub struct WallGran {
     /// The next post_force is the setup force evaluation: history does not
     /// advance (LAMMPS/LIGGGHTS `update->setupflag`).
     in_setup: bool,
+    /// LAMMPS `zcylinder` radius: R* includes the wall's curvature.
+    cyl_radius: Option<f64>,
+    /// JKR normal law: contacts last beyond touching.
+    jkr: bool,
 }
 
 impl Fix for WallGran {
@@ -60,23 +66,40 @@ impl Fix for WallGran {
                 continue;
             }
             let hist = &mut p.extra[col].data[i * w..i * w + self.width];
-            let Some((delta, n, _pt)) = self.wall.contact(p.x[i], p.radius[i], shift) else {
+            let ri = p.radius[i];
+            let pp = self.table.get(p.kind[i], self.wall_type);
+            // a JKR contact lives on to the pull-off overlap (< 0): look that
+            // far; LAMMPS's zcylinder finds no contact once the sphere is
+            // off the wall (its `delr > radius` test)
+            let reach = if self.jkr && self.cyl_radius.is_none() { -jkr_pulloff_overlap(ri, pp.y_eff, pp.cohesion) } else { 0.0 };
+            let Some((delta, n, _pt)) = self.wall.contact(p.x[i], ri + reach, shift) else {
                 hist.fill(0.0);
                 continue;
             };
-            if delta <= 0.0 {
+            let delta = delta - reach;
+            if delta <= 0.0 && !self.jkr {
                 hist.fill(0.0);
                 continue;
             }
+            // LAMMPS zcylinder: the wall's curvature enters R* through
+            // rwall = -2 R_c (met from inside) or +2 R_c (outside)
+            let r_eff = match self.cyl_radius {
+                Some(rc) => {
+                    let rho = (p.x[i].x * p.x[i].x + p.x[i].y * p.x[i].y).sqrt();
+                    let rwall = if rho < rc { -2.0 * rc } else { 2.0 * rc };
+                    ri * rwall / (ri + rwall)
+                }
+                None => ri,
+            };
             let mi = p.mass[i];
             let vr = p.v[i] - vwall;
             let c = Contact {
                 n,
-                r: p.radius[i] - delta,
+                r: ri - delta,
                 delta,
-                ri: p.radius[i],
+                ri,
                 rj: f64::INFINITY,
-                r_eff: p.radius[i],
+                r_eff,
                 mi,
                 mj: f64::INFINITY,
                 m_eff: mi,
@@ -86,7 +109,6 @@ impl Fix for WallGran {
                 wj: V3::zeros(),
                 dt,
             };
-            let pp = self.table.get(p.kind[i], self.wall_type);
             let out = self.kernel.contact(&c, pp, hist);
             p.f[i] += out.force_i(&c);
             p.torque[i] += out.torque_i;
@@ -182,7 +204,26 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
                 spec.normal = if style_name == "hertz/history" { NormalSpec::GranHertz } else { NormalSpec::GranHooke };
                 spec.tangential = if style_name == "hooke" { TangentialSpec::GranNoHistory } else { TangentialSpec::GranHistory };
             }
-            "granular" => return Err(Error::unsupported(first.span, "fix wall/gran granular")),
+            "granular" => {
+                let (gspec, table) = granular_coeffs(s, cmd, a, first)?;
+                let words = a.rest().to_vec();
+                let (wall, motion, used) = PrimitiveWall::parse_lammps(cmd, &words)?;
+                a.pos += used;
+                while a.more() {
+                    let k = a.word("keyword")?;
+                    if k.text == "contacts" {
+                        continue;
+                    }
+                    return Err(Error::deck(k.span, format!("fix wall/gran: unknown keyword '{}'", k.text)));
+                }
+                if matches!(gspec.normal, NormalSpec::GranularCohesive(model::CohesiveNormal::Jkr, _)) {
+                    s.notes.push((
+                        first.span,
+                        "fix wall/gran granular jkr: LAMMPS 29 Sep 2021 turns a sphere leaving a JKR wall into NaN; demx ends the contact at the JKR pull-off overlap, as for pairs".into(),
+                    ));
+                }
+                return add_wall(s, id, group, gspec, table, 1, wall, motion);
+            }
             _ => {
                 return Err(super::args::bad_keyword(first, "wall/gran style", &["model", "hooke", "hooke/history", "hertz/history", "granular"])
                     .with_hint("LIGGGHTS 2.x `wall/gran/hertz/history` forms are converted by `demx convert`"))
@@ -203,12 +244,25 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
         (spec, table, 1, wall, motion)
     };
     let _ = style;
+    add_wall(s, id, group, spec, table, wall_type, wall, motion)
+}
+
+/// Register a primitive wall fix running `spec`'s laws with `table`.
+#[allow(clippy::too_many_arguments)]
+fn add_wall(s: &mut Session, id: &str, group: u32, spec: PairSpec, table: ParamTable, wall_type: u32, wall: PrimitiveWall, motion: WallMotion) -> Result<()> {
     let kernel = model::build_kernel(&spec)?;
     let width = kernel.history_width();
     let summary = format!("wall/gran {} ({:?}): {}", id, wall, spec.summary());
     s.walls.push(summary.clone());
     let t0 = s.sim.time;
+    let cyl_radius = match wall {
+        PrimitiveWall::LammpsZCylinder { radius } => Some(radius),
+        _ => None,
+    };
+    let jkr = matches!(spec.normal, NormalSpec::GranularCohesive(model::CohesiveNormal::Jkr, _));
     s.add_fix(Box::new(WallGran {
+        cyl_radius,
+        jkr,
         id: id.to_string(),
         group,
         wall,
@@ -224,3 +278,108 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
     }))
 }
 
+
+// ------------------------------------------------------------ LAMMPS granular walls
+
+/// Words that end the coefficient block of `fix wall/gran granular` (the
+/// wall style; LAMMPS 29 Sep 2021 `FixWallGran` stops at these).
+const GRANULAR_WALL_STYLES: &[&str] = &["xplane", "yplane", "zplane", "zcylinder", "region"];
+
+/// Number of coefficients after each normal model name.
+fn normal_arity(name: &str) -> Option<usize> {
+    match name {
+        "hooke" | "hertz" => Some(2),
+        "hertz/material" => Some(3),
+        "dmt" | "jkr" => Some(4),
+        _ => None,
+    }
+}
+
+/// Parse the coefficient block of `fix wall/gran granular` and
+/// `fix wall/gran/region granular` (the cursor stands after `granular`; it
+/// is left on the wall style word). The block has the syntax of a
+/// `pair_coeff` line of `pair_style granular` and is read by the same parser;
+/// then the values LAMMPS 29 Sep 2021 derives differently for a wall are
+/// replaced (verified with lmp, a sphere pressed into a zplane):
+///
+/// * material models (hertz/material, dmt, jkr): the wall is the particle's
+///   material, but the effective modulus is `E / (2 (1 - nu))`, not the
+///   pair mixing `E / (2 (1 - nu^2))`, so `k_n = 4/3 E / (2 (1 - nu))`;
+/// * `tangential mindlin* NULL ...`: `k_t = E / 4 (2 - nu) (1 + nu)`
+///   (the pair value is `8 G* = 2 E / ((2 - nu)(1 + nu))`).
+///
+/// Every particle type meets the wall with the same coefficients.
+///
+/// Known differences from lmp, not reproduced: a DMT wall contact that
+/// attracts (F_ne < 0) and slides is capped by lmp at mu (|F_ne| - ~2.5e-8 N)
+/// (constant offset, independent of E, gamma, mass, k_t; demx caps at
+/// mu |F_ne| as for pairs); a sphere leaving a JKR wall turns into NaN in lmp.
+pub fn granular_coeffs(s: &mut Session, cmd: &Command, a: &mut Args, style: &Word) -> Result<(PairSpec, ParamTable)> {
+    let rest = a.rest();
+    let end = rest.iter().position(|w| GRANULAR_WALL_STYLES.contains(&w.text.as_str())).ok_or_else(|| {
+        Error::deck(a.end_span(), "fix wall/gran granular: missing the wall style (xplane, yplane, zplane, zcylinder or region)")
+    })?;
+    let block = &rest[..end];
+    // LAMMPS takes the sub-models in any order; the pair_coeff parser wants
+    // the normal model first
+    let k = block.iter().position(|w| normal_arity(&w.text).is_some()).ok_or_else(|| {
+        let at = block.first().map(|w| w.span).unwrap_or(style.span);
+        Error::deck(at, "fix wall/gran granular: missing the normal model (hooke, hertz, hertz/material, dmt or jkr)")
+    })?;
+    let n = normal_arity(&block[k].text).unwrap_or(0);
+    if k + n >= block.len() {
+        return Err(Error::deck(block[k].span, format!("fix wall/gran granular: {} needs {n} coefficients", block[k].text)));
+    }
+    if let Some(c) = block.iter().find(|w| w.text == "cutoff") {
+        return Err(Error::deck(c.span, "Unknown fix wall/gran keyword cutoff"));
+    }
+    if !block.iter().any(|w| w.text == "tangential") {
+        return Err(Error::unsupported(style.span, "fix wall/gran granular without a tangential model")
+            .with_hint("add e.g. `tangential linear_nohistory 0 0` (LAMMPS 29 Sep 2021 leaves the default undocumented)"));
+    }
+    let mut words: Vec<Word> = Vec::with_capacity(block.len() + 3);
+    let synth = |t: &str| Word { text: t.to_string(), span: style.span, quoted: false };
+    words.push(synth("pair_coeff"));
+    words.push(synth("*"));
+    words.push(synth("*"));
+    words.extend(block[k..=k + n].iter().cloned());
+    words.extend(block[..k].iter().cloned());
+    words.extend(block[k + n + 1..].iter().cloned());
+    let kt_null = block.windows(3).any(|w| w[0].text == "tangential" && w[1].text.starts_with("mindlin") && w[2].text == "NULL");
+    let coeff = Command { words, span: cmd.span };
+    // the pair parser records into the pair spec: give it a scratch one
+    let mut scratch = PairSpec::new(cmd.span, true);
+    scratch.normal = NormalSpec::Granular(GranularNormal::Hertz, GranularDamping::Viscoelastic);
+    let saved = s.pair.replace(scratch);
+    let parsed = model::execute(s, &coeff);
+    let got = std::mem::replace(&mut s.pair, saved);
+    parsed.map_err(|e| match e {
+        Error::Deck { span, msg, hint } => Error::Deck { span, msg: msg.replace("pair_coeff", "fix wall/gran granular"), hint },
+        other => other,
+    })?;
+    a.pos += end;
+    let got = got.ok_or_else(|| Error::deck(style.span, "fix wall/gran granular: no coefficients"))?;
+    let mut pp = got.granular.first().map(|g| g.2).ok_or_else(|| Error::deck(style.span, "fix wall/gran granular: no coefficients"))?;
+    let material = matches!(got.normal, NormalSpec::Granular(GranularNormal::HertzMaterial, _) | NormalSpec::GranularCohesive(..));
+    if material {
+        let nu = pp.poisson;
+        let e_young = pp.y_eff * 2.0 * (1.0 - nu * nu);
+        pp.y_eff = e_young / (2.0 * (1.0 - nu));
+        pp.kn = 4.0 / 3.0 * pp.y_eff;
+        if kt_null {
+            pp.kt = e_young / 4.0 * (2.0 - nu) * (1.0 + nu);
+        }
+    }
+    let mut spec = PairSpec::new(cmd.span, true);
+    spec.normal = got.normal;
+    spec.tangential = got.tangential;
+    spec.rolling = got.rolling;
+    spec.limit_damping = pp.limit_damping != 0.0;
+    let mut table = ParamTable::new(s.sim.ntypes.max(1));
+    for p in table.params.iter_mut() {
+        *p = pp;
+    }
+    // demx run --youngs-scale divides every stiffness (pairs and walls)
+    super::overrides::scale_table(s, &mut table);
+    Ok((spec, table))
+}
