@@ -251,3 +251,63 @@ fn demx_runs_the_converted_random_packing() {
         }
     }
 }
+
+/// A sphere dropped on a primitive wall: the LAMMPS conversion must give
+/// LIGGGHTS' wall force (Hertz stiffness from Y* = Y/(2(1-nu^2)), damping
+/// from e), although LAMMPS' wall/gran granular derives its modulus as
+/// E/(2(1-nu)) and tsuji damping from another e.
+#[test]
+fn converted_wall_bounces_like_the_liggghts_wall() {
+    if !on_path("lmp") || !on_path("liggghts") {
+        eprintln!("skip: lmp or liggghts not on PATH");
+        return;
+    }
+    let deck = "atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region reg block -0.01 0.01 -0.01 0.01 0 0.02 units box
+create_box 1 reg
+neighbor 0.0002 bin
+fix m1 all property/global youngsModulus peratomtype 1e7
+fix m2 all property/global poissonsRatio peratomtype 0.24
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.5
+pair_style gran model hertz tangential history
+pair_coeff * *
+timestep 1e-6
+fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0
+create_atoms 1 single 0 0 0.0006 units box
+set atom 1 diameter 0.001 density 2500
+velocity all set 0 0 -0.5 units box
+fix integr all nve/sphere
+variable z equal z[1]
+variable vz equal vz[1]
+thermo_style custom step v_z v_vz
+thermo_modify format float %.12g
+thermo 20
+run 400
+";
+    let c = convert(deck, Target::Lammps);
+    let series = |exe: &str, text: &str| -> Vec<(f64, f64)> {
+        let dir = tempfile::tempdir().expect("tmp");
+        let (ok, out) = run(exe, text, dir.path(), &[]);
+        assert!(ok, "{exe}: {out}\n{text}");
+        out.lines()
+            .filter_map(|l| {
+                let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().ok()).collect::<Option<_>>()?;
+                (v.len() == 3).then(|| (v[1], v[2]))
+            })
+            .collect()
+    };
+    let (a, b) = (series("lmp", &c.text), series("liggghts", deck));
+    assert!(a.len() >= 20 && a.len() == b.len(), "{} vs {} rows", a.len(), b.len());
+    // the contact starts at step 200 (0.1 mm at 0.5 m/s) and lasts ~80 steps
+    let rebound = b.last().map(|r| r.1).unwrap_or(0.0);
+    assert!(rebound > 0.1, "the sphere bounced: {rebound}");
+    for (k, (p, q)) in a.iter().zip(&b).enumerate() {
+        assert!((p.0 - q.0).abs() < 1e-9 && (p.1 - q.1).abs() < 1e-6 * 0.5, "row {k}: lmp {p:?} liggghts {q:?}");
+    }
+}

@@ -125,7 +125,10 @@ fn parse_model3(w: &[String]) -> Option<(Model3, Vec<String>)> {
 }
 
 /// LAMMPS granular coefficient string for type pair (i, j) under model `m`.
-fn granular_coeffs(ctx: &mut Ctx, m: &Model3, i: usize, j: usize) -> Option<String> {
+/// `wall`: the coefficients of a `fix wall/gran granular`, where LAMMPS
+/// 2021 takes the wall's effective modulus as E/(2(1-nu)) (measured; pairs:
+/// E/(2(1-nu^2)) from the mixing rule), so E is chosen to give LIGGGHTS' Y*.
+fn granular_coeffs(ctx: &mut Ctx, m: &Model3, i: usize, j: usize, wall: bool) -> Option<String> {
     let f = ctx.facts;
     match m.normal.as_str() {
         "hertz" => {
@@ -137,7 +140,7 @@ fn granular_coeffs(ctx: &mut Ctx, m: &Model3, i: usize, j: usize) -> Option<Stri
                     0.0
                 }
             };
-            let e_lmp = 2.0 * (1.0 - p.nu * p.nu) * p.y_star;
+            let e_lmp = if wall { 2.0 * (1.0 - p.nu) * p.y_star } else { 2.0 * (1.0 - p.nu * p.nu) * p.y_star };
             let xgt = if m.tangential_damping { 2.0 * (p.g_star / p.y_star).sqrt() } else { 0.0 };
             let tang = match m.tangential.as_str() {
                 "history" => format!("mindlin {} {} {}", fmt(8.0 * p.g_star), fmt(xgt), fmt(p.mu)),
@@ -318,7 +321,7 @@ pub fn pair_coeff_to_lammps(ctx: &mut Ctx, _w: &[String]) -> Option<Action> {
     let mut lines = Vec::new();
     for i in 1..=n {
         for j in i..=n {
-            match granular_coeffs(ctx, &m, i, j) {
+            match granular_coeffs(ctx, &m, i, j, false) {
                 Some(c) => lines.push(format!("pair_coeff {i} {j} {c}")),
                 None => return Some(Action::Drop(format!("model {} or its material properties (constant numbers) not convertible", m.normal), Severity::Dropped)),
             }
@@ -344,7 +347,7 @@ fn wall_coeffs(ctx: &mut Ctx, m: &Model3, t: usize) -> Option<String> {
         };
         return Some(format!("{style} {} {} {} {} {} 1", fmt(v[0]), fmt(v[1]), fmt(v[2]), fmt(v[3]), fmt(v[4])));
     }
-    Some(format!("granular {}", granular_coeffs(ctx, m, 1, t)?))
+    Some(format!("granular {}", granular_coeffs(ctx, m, 1, t, true)?))
 }
 
 /// 3.x `fix ID G wall/gran model ... primitive type T geom args` -> LAMMPS.

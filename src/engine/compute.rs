@@ -197,10 +197,17 @@ pub fn atom_property(sim: &Sim, name: &str, i: usize) -> Option<f64> {
 
 /// Group functions of the variable language: count, mass, xcm, vcm, ke, bound.
 pub fn group_function(sim: &Sim, name: &str, args: &[&str]) -> Result<f64, String> {
+    group_function_in(sim, name, args, &|_| true)
+}
+
+/// Group functions restricted to the particles `inside` accepts (the
+/// optional region argument, e.g. `count(all,col)`, resolved by the caller
+/// and removed from `args`).
+pub fn group_function_in(sim: &Sim, name: &str, args: &[&str], inside: &dyn Fn(usize) -> bool) -> Result<f64, String> {
     let g = args.first().ok_or_else(|| format!("{name}() needs a group"))?;
     let bit = sim.group_bit(g).ok_or_else(|| format!("group {g} does not exist"))?;
     let p = &sim.particles;
-    let members = || (0..p.len()).filter(move |&i| p.mask[i] & bit != 0);
+    let members = || (0..p.len()).filter(move |&i| p.mask[i] & bit != 0 && inside(i));
     let dim = |s: Option<&&str>| -> Result<usize, String> {
         match s.copied() {
             Some("x") => Ok(0),
@@ -212,7 +219,7 @@ pub fn group_function(sim: &Sim, name: &str, args: &[&str]) -> Result<f64, Strin
     Ok(match name {
         "count" => members().count() as f64,
         "mass" => members().map(|i| p.mass[i]).sum(),
-        "ke" => sim.kinetic_energy(bit),
+        "ke" => members().map(|i| 0.5 * p.mass[i] * p.v[i].norm_squared()).sum(),
         "xcm" | "vcm" | "fcm" => {
             let k = dim(args.get(1))?;
             let m: f64 = members().map(|i| p.mass[i]).sum();

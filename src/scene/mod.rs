@@ -459,6 +459,19 @@ impl EvalContext for Session {
         self.sim.atom_value(k, id)
     }
     fn group_function(&self, name: &str, args: &[&str]) -> std::result::Result<f64, String> {
+        // the optional last argument is a region (LAMMPS: count(g,R),
+        // mass(g,R), ke(g,R), xcm(g,dim,R), vcm, fcm, bound(g,dir,R))
+        let plain = match name {
+            "count" | "mass" | "ke" => 1,
+            "xcm" | "vcm" | "fcm" | "bound" => 2,
+            _ => usize::MAX,
+        };
+        if args.len() == plain + 1 {
+            let rid = args[plain];
+            let r = self.regions.iter().find(|r| r.id == rid).ok_or_else(|| format!("region {rid} does not exist"))?;
+            let x = &self.sim.particles.x;
+            return crate::engine::compute::group_function_in(&self.sim, name, &args[..plain], &|i| r.contains(x[i]));
+        }
         self.sim.group_function(name, args)
     }
     fn natoms(&self) -> usize {
