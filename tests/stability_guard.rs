@@ -227,3 +227,44 @@ fn settle_deck_is_bitwise_unchanged_by_the_guard() {
     assert!(a.len() > 100_000 && a == b, "settle dumps differ with the guard on and off");
     assert!(!dir.path().join("demx.lastgood.data").exists());
 }
+
+/// One sphere (d = 2 mm) above a LIGGGHTS primitive zplane wall at z = 0,
+/// at height `z0` moving down at 1 m/s.
+fn wall_deck(dt: f64, z0: f64) -> String {
+    headon(dt, "")
+        .replace("create_atoms 1 single 0.006 0.0 0.0 units box\n", "")
+        .replace("create_atoms 1 single -0.006 0.0 0.0 units box", &format!("create_atoms 1 single 0.0 0.0 {z0} units box"))
+        .replace("set atom 1*2", "set atom 1")
+        .replace("group b id 2\n", "")
+        .replace("velocity b set -1.0 0.0 0.0 units box\n", "")
+        .replace("velocity a set 1.0 0.0 0.0 units box", "velocity a set 0.0 0.0 -1.0 units box\nfix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0")
+}
+
+#[test]
+fn deep_wall_overlap_is_stopped_and_names_the_wall() {
+    // placed 0.8 R into the wall: stopped before the first step
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = run(dir.path(), &wall_deck(1e-6, 0.0002));
+    let msg = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{msg}");
+    assert!(msg.contains("particle 1 overlaps wall (fix floor"), "{msg}");
+    assert!(msg.contains("80%"), "{msg}");
+    // hitting the wall with the time step at 1.5 x the wall's Hertz time
+    // (m* = m, R* = R: 2^(1/5) x the pair's; 0.35 R of travel per step, under
+    // the travel limit): stopped at the impact, not after the run
+    let th = hertz_time() * 2f64.powf(0.2);
+    let dt = 1.5 * th;
+    let z0 = 0.0015;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = run(dir.path(), &wall_deck(dt, z0));
+    let msg = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{msg}");
+    assert!(msg.contains("stability guard") && msg.contains("timestep too large for the stiffness"), "{msg}");
+    let contact = ((z0 - 0.001) / dt).ceil() as i64;
+    let step = stop_step(&msg);
+    assert!(step >= contact && step <= contact + 20, "stopped at step {step}, contact at {contact}: {msg}");
+    // the same run with a sane step bounces and finishes
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = run(dir.path(), &wall_deck(0.02 * th, z0));
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+}

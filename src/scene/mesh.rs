@@ -411,6 +411,39 @@ impl Fix for WallGranMesh {
     fn summary(&self) -> String {
         self.summary.clone()
     }
+    fn max_surface_overlap(&self, sim: &Sim) -> Option<(usize, f64)> {
+        let p = &sim.particles;
+        let mut worst: Option<(usize, f64)> = None;
+        for i in 0..p.len() {
+            if p.mask[i] & self.group == 0 {
+                continue;
+            }
+            if let Some(d) = self.surface_overlap(sim, i) {
+                let f = d / p.radius[i];
+                if worst.is_none_or(|w| f > w.1) {
+                    worst = Some((i, f));
+                }
+            }
+        }
+        worst
+    }
+    fn surface_overlap(&self, sim: &Sim, i: usize) -> Option<f64> {
+        // the deepest triangle contact, read only (no history slots touched)
+        let p = &sim.particles;
+        let mut deepest: Option<f64> = None;
+        for wm in &self.meshes {
+            let Ok(mesh) = wm.mesh.read() else { continue };
+            let pref = mesh.to_reference(p.x[i], sim.time);
+            for t in mesh.bins.candidates(pref, p.radius[i]) {
+                if let Some((delta, _, _)) = mesh.triangle_contact(t, pref, p.radius[i]) {
+                    if delta > 0.0 && deepest.is_none_or(|d| delta > d) {
+                        deepest = Some(delta);
+                    }
+                }
+            }
+        }
+        deepest
+    }
 }
 
 fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args) -> Result<()> {

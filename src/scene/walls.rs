@@ -118,6 +118,27 @@ impl Fix for WallGran {
     fn summary(&self) -> String {
         self.summary.clone()
     }
+    fn max_surface_overlap(&self, sim: &Sim) -> Option<(usize, f64)> {
+        let p = &sim.particles;
+        let mut worst: Option<(usize, f64)> = None;
+        for i in 0..p.len() {
+            if p.mask[i] & self.group == 0 {
+                continue;
+            }
+            if let Some(d) = self.surface_overlap(sim, i) {
+                let f = d / p.radius[i];
+                if worst.is_none_or(|w| f > w.1) {
+                    worst = Some((i, f));
+                }
+            }
+        }
+        worst
+    }
+    fn surface_overlap(&self, sim: &Sim, i: usize) -> Option<f64> {
+        let shift = self.motion.shift(self.wall.axis(), sim.time - self.t0);
+        let p = &sim.particles;
+        self.wall.contact(p.x[i], p.radius[i], shift).map(|c| c.0).filter(|d| *d > 0.0)
+    }
 }
 
 /// Parse `fix ID group wall/gran ...` in either dialect.
