@@ -55,9 +55,10 @@ CASES = [
 ]
 
 
-def sh(cmd, cwd, timeout=3600):
+def sh(cmd, cwd, timeout=3600, merge=True):
+    """Run; (exit code, stdout (+ stderr when merge), seconds)."""
     t0 = time.time()
-    p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT if merge else subprocess.PIPE, text=True, timeout=timeout)
     return p.returncode, p.stdout, time.time() - t0
 
 
@@ -91,7 +92,7 @@ def convert(demx, text, work):
     src = os.path.join(work, "orig.deck")
     with open(src, "w") as f:
         f.write(text)
-    code, out, _ = sh([demx, "convert", src, "--to", "lammps", "--json"], work)
+    code, out, _ = sh([demx, "convert", src, "--to", "lammps", "--json"], work, merge=False)
     if code not in (0, 4):
         raise RuntimeError(f"demx convert failed ({code}): {out[:300]}")
     j = json.loads(out)
@@ -100,8 +101,8 @@ def convert(demx, text, work):
 
 def compare(demx, a, b, heap=False):
     cmd = [demx, "compare", a, b, "--json"] + (["--heap"] if heap else [])
-    code, out, _ = sh(cmd, ROOT)
-    j = json.loads(out[out.index("{"):])
+    code, out, _ = sh(cmd, ROOT, merge=False)
+    j = json.loads(out)
     return j
 
 

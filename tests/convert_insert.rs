@@ -131,10 +131,30 @@ fn insert_every_counts_the_insertions_until_unfix() {
     // see insertions at steps 1, 3001, 6001 and 9001, then `unfix`
     let deck = pack_deck("particles_in_region 250").replace("insert_every once", "insert_every 3000").replace(
         "run 1\n",
-        "run 1\nrun 10000\nunfix ins\nrun 5000\n",
+        "thermo_modify lost ignore\nrun 1\nrun 10000\nunfix ins\nrun 5000\n",
     );
     let c = convert(&deck, Target::Lammps);
-    let pour = c.text.lines().find(|l| l.contains(" pour ")).unwrap_or_else(|| panic!("no fix pour:\n{}", c.text));
+    // a packing pass now, and the runs split before the insertion steps 3001,
+    // 6001 and 9001, each followed by a pass; `unfix ins` ends them
+    let cmds: Vec<String> = c.text.lines().filter(|l| l.starts_with("run") || l.starts_with("label demx_rsa") && !l.ends_with("_end") || l.starts_with("unfix")).map(|l| l.split_whitespace().collect::<Vec<_>>().join(" ")).collect();
+    assert_eq!(
+        cmds,
+        ["label demx_rsa1_1", "run 1", "run 2999", "label demx_rsa1_2", "run 3000", "label demx_rsa1_3", "run 3000", "label demx_rsa1_4", "run 1001", "run 5000"],
+        "{}",
+        c.text
+    );
+    // each pass tops the region up to 250 particles
+    assert_eq!(c.text.matches("variable demx_nins equal (250)-count(all,ins)").count(), 4, "{}", c.text);
+    // no fix pour is left, and the deck runs in the real lmp
+    assert!(!c.text.lines().any(|l| l.contains(" pour ")), "{}", c.text);
+    if on_path("lmp") {
+        let dir = tempfile::tempdir().expect("tmp");
+        let (ok, out) = run("lmp", &c.text, dir.path(), &[]);
+        assert!(ok, "{out}");
+    }
+    // a polydisperse or looped insertion keeps the fix pour of N x the insertions
+    let plain = convert(&deck.replace("pair_style gran model hertz tangential history\npair_coeff * *\n", ""), Target::Lammps);
+    let pour = plain.text.lines().find(|l| l.contains(" pour ")).unwrap_or_else(|| panic!("no fix pour:\n{}", plain.text));
     let w: Vec<&str> = pour.split_whitespace().collect();
     assert_eq!(w[4], "1000", "4 insertions x 250: {pour}");
     // vol: 250 particles of d = 1 mm in the 8 x 8 x 15 mm region

@@ -529,6 +529,7 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
             return Some(pack_once_rsa(ctx, id, &region, &n, &ty, &seed, sizes[0].0, dlo, w));
         }
     }
+    let referenced_later = ctx.all.get(ctx.pos + 1..).unwrap_or(&[]).iter().any(|l| l.iter().any(|x| x.contains(&format!("f_{id}"))));
     let constant_region = f.regions.get(&region).is_some_and(|r| r.args.iter().all(|a| !a.contains('$'))) && !id.contains('$');
     let mut lines = Vec::new();
     let (count, frac) = match (&target, once) {
@@ -559,6 +560,14 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
                 return Some(Action::Drop("number of particles to insert not known as a constant".into(), Severity::Dropped));
             };
             (fmt(n), one_batch_fraction(t, n, vp, vol_now))
+        }
+        (Some(t), false) if sizes.len() == 1 && pair_before && !referenced_later && every.as_deref().and_then(|e| f.num(e)).is_some_and(|e| e >= 1.0) && insertions_until_unfix(ctx, id, 1).is_some() && per_insert(t).is_some() => {
+            let e = every.as_deref().and_then(|e| f.num(e)).unwrap_or(1.0) as u64;
+            let n = per_insert(t).unwrap_or_default();
+            if let Some(a) = pack_every_rsa(ctx, id, &region, &n, &ty, &seed, sizes[0].0, dlo, w, e) {
+                return Some(a);
+            }
+            return Some(Action::Drop("insert/pack every E: runs not constant".into(), Severity::Dropped));
         }
         (Some(t), false) => {
             // refills every E steps while the fix lives: N per insertion x the
@@ -633,26 +642,107 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     Some(Action::Replace(lines))
 }
 
-/// `insert/pack ... insert_every once` of one sphere size -> a random
-/// sequential packing with LAMMPS commands: `create_atoms random` of the
-/// missing number in the region (shrunk by the radius for `all_in yes`),
-/// `delete_atoms overlap` of the candidates that touch anything, repeated
-/// until the count is reached (LAMMPS 29Sep2021 `create_atoms` has no
-/// overlap check, and fix pour cannot fill a region densely: it stacks its
-/// particles toward the top). The particles exist at once (LIGGGHTS: on the
-/// next step) with the deck's velocity.
-fn pack_once_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &str, seed: &str, diam: f64, dens: f64, w: &[String]) -> Action {
+/// One random sequential packing pass, as LAMMPS commands: fill `region` up
+/// to `per_insert` particles (a formula; what is there already counts) with
+/// `create_atoms random` in `target` and `delete_atoms overlap` of the
+/// candidates that touch anything, looped (labels `label`, `label`_end)
+/// until the count is reached; then the new particles get the velocity.
+#[derive(Clone, Debug)]
+pub struct RsaBlock {
+    group: String,
+    region: String,
+    target: String,
+    per_insert: String,
+    ty: String,
+    seed: String,
+    diam: f64,
+    dens: f64,
+    vel: (String, String, String),
+}
+
+impl RsaBlock {
+    fn lines(&self, label: &str) -> Vec<String> {
+        let RsaBlock { group, region, target, per_insert, ty, seed, diam, dens, vel } = self;
+        let end = format!("{label}_end");
+        let mut v: Vec<String> = vec![
+            "group demx_old empty".to_string(),
+            "group demx_old clear".into(),
+            "group demx_old union all".into(),
+            format!("variable demx_nins equal ({per_insert})-count(all,{region})"),
+            "variable demx_T equal $(count(all)+v_demx_nins)".into(),
+            "variable demx_step0 equal $(step)".into(),
+            "variable demx_r loop 1000".into(),
+            format!("label {label}"),
+            "variable demx_left equal v_demx_T-count(all)".into(),
+            format!("if \"${{demx_left}} <= 0\" then \"jump SELF {end}\""),
+            "group demx_pre empty".into(),
+            "group demx_pre clear".into(),
+            "group demx_pre union all".into(),
+            format!("variable demx_seed equal {seed}+v_demx_r"),
+            format!("create_atoms {ty} random ${{demx_left}} ${{demx_seed}} {target}"),
+            "group demx_cand empty".into(),
+            "group demx_cand clear".into(),
+            "group demx_cand subtract all demx_pre".into(),
+            format!("set group demx_cand diameter {}", fmt(*diam)),
+            format!("set group demx_cand density {}", fmt(*dens)),
+            // LAMMPS 29Sep2021 reuses delete_atoms' neighbour list within one
+            // time step (observed: the second pass misses overlaps): step on
+            "reset_timestep $(step+1)".into(),
+            format!("delete_atoms overlap {} demx_cand all compress yes", fmt(*diam)),
+            "next demx_r".into(),
+            format!("jump SELF {label}"),
+            format!("label {end}"),
+            "variable demx_r delete".into(),
+            "reset_timestep ${demx_step0}".into(),
+            "group demx_new empty".into(),
+            "group demx_new clear".into(),
+            "group demx_new subtract all demx_old".into(),
+            format!("velocity demx_new set {} {} {} units box", vel.0, vel.1, vel.2),
+        ];
+        // the insert fix's group, as LIGGGHTS gives it to what it inserts
+        if group != "all" {
+            v.push(format!("group {group} union {group} demx_new"));
+        }
+        v
+    }
+}
+
+/// A repeated insertion (insert/pack every E steps) turned into packing
+/// passes between split runs.
+#[derive(Clone, Debug)]
+pub struct InsertSchedule {
+    /// The insert fix ID (its `unfix` ends the schedule).
+    pub id: String,
+    /// Steps between insertions.
+    pub every: u64,
+    /// Absolute step of the next insertion.
+    pub next: u64,
+    block: RsaBlock,
+    label: String,
+    passes: usize,
+}
+
+impl InsertSchedule {
+    /// The packing pass that inserts at step `self.next`.
+    pub fn pass(&mut self) -> Vec<String> {
+        self.passes += 1;
+        self.next += self.every;
+        self.block.lines(&format!("{}_{}", self.label, self.passes))
+    }
+}
+
+/// The packing block of an insert fix, and the lines that define the region
+/// its centres go in (shrunk by the radius for `all_in yes`, box units).
+fn rsa_setup(ctx: &Ctx, k: usize, region: &str, per_insert: &str, ty: &str, seed: &str, diam: f64, dens: f64, w: &[String]) -> (Vec<String>, RsaBlock) {
     let f = ctx.facts;
-    let k = ctx.inserts_seen;
     let get = |key: &str| w.iter().position(|x| x == key).and_then(|i| w.get(i + 1)).cloned();
-    let (vx, vy, vz) = match w.iter().position(|x| x == "vel") {
+    let vel = match w.iter().position(|x| x == "vel") {
         Some(i) if w.get(i + 1).map(|s| s.as_str()) == Some("constant") && w.len() >= i + 5 => (w[i + 2].clone(), w[i + 3].clone(), w[i + 4].clone()),
         _ => ("0".into(), "0".into(), "0".into()),
     };
     let r = diam / 2.0;
-    let mut lines = vec![format!("# demx: {id} = insert/pack once -> random sequential packing (create_atoms random + delete_atoms overlap)")];
-    // the region the centres go in: shrunk by r for all_in yes (box units only)
-    let mut target_region = region.to_string();
+    let mut lines = Vec::new();
+    let mut target = region.to_string();
     if get("all_in").as_deref() == Some("yes") {
         if let Some(rd) = f.regions.get(region).filter(|rd| rd.args.windows(2).any(|p| p[0] == "units" && p[1] == "box")) {
             let sh = fmt(r);
@@ -680,47 +770,25 @@ fn pack_once_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &s
                     }
                 }
                 // named after the region, so that a region re-made in a loop (`col${k}`) gets a fresh one
-                target_region = format!("demx_in{k}_{region}");
-                lines.push(format!("region {target_region} {} {} units box", rd.style, words.join(" ")));
+                target = format!("demx_in{k}_{region}");
+                lines.push(format!("region {target} {} {} units box", rd.style, words.join(" ")));
             }
         }
     }
-    let (top, end) = (format!("demx_rsa{k}"), format!("demx_rsa{k}_end"));
-    lines.extend([
-        "group demx_old empty".to_string(),
-        "group demx_old clear".into(),
-        "group demx_old union all".into(),
-        format!("variable demx_nins equal ({per_insert})-count(all,{region})"),
-        "variable demx_T equal $(count(all)+v_demx_nins)".into(),
-        "variable demx_step0 equal $(step)".into(),
-        "variable demx_r loop 1000".into(),
-        format!("label {top}"),
-        "variable demx_left equal v_demx_T-count(all)".into(),
-        format!("if \"${{demx_left}} <= 0\" then \"jump SELF {end}\""),
-        "group demx_pre empty".into(),
-        "group demx_pre clear".into(),
-        "group demx_pre union all".into(),
-        format!("variable demx_seed equal {seed}+v_demx_r"),
-        format!("create_atoms {ty} random ${{demx_left}} ${{demx_seed}} {target_region}"),
-        "group demx_cand empty".into(),
-        "group demx_cand clear".into(),
-        "group demx_cand subtract all demx_pre".into(),
-        format!("set group demx_cand diameter {}", fmt(diam)),
-        format!("set group demx_cand density {}", fmt(dens)),
-        // LAMMPS 29Sep2021 reuses delete_atoms' neighbour list within one
-        // time step (observed: the second pass misses overlaps): step on
-        "reset_timestep $(step+1)".into(),
-        format!("delete_atoms overlap {} demx_cand all compress yes", fmt(diam)),
-        "next demx_r".into(),
-        format!("jump SELF {top}"),
-        format!("label {end}"),
-        "variable demx_r delete".into(),
-        "reset_timestep ${demx_step0}".into(),
-        "group demx_new empty".into(),
-        "group demx_new clear".into(),
-        "group demx_new subtract all demx_old".into(),
-        format!("velocity demx_new set {vx} {vy} {vz} units box"),
-    ]);
+    let group = w.get(2).cloned().unwrap_or_else(|| "all".into());
+    let block = RsaBlock { group, region: region.into(), target, per_insert: per_insert.into(), ty: ty.into(), seed: seed.into(), diam, dens, vel };
+    (lines, block)
+}
+
+/// `insert/pack ... insert_every once` of one sphere size -> one packing
+/// pass (LAMMPS 29Sep2021 `create_atoms` has no overlap check, and fix pour
+/// cannot fill a region densely: it stacks its particles toward the top).
+/// The particles exist at once (LIGGGHTS: on the next step).
+fn pack_once_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &str, seed: &str, diam: f64, dens: f64, w: &[String]) -> Action {
+    let k = ctx.inserts_seen;
+    let (mut lines, block) = rsa_setup(ctx, k, region, per_insert, ty, seed, diam, dens, w);
+    lines.insert(0, format!("# demx: {id} = insert/pack once -> random sequential packing (create_atoms random + delete_atoms overlap)"));
+    lines.extend(block.lines(&format!("demx_rsa{k}")));
     let referenced = ctx.all.get(ctx.pos + 1..).unwrap_or(&[]).iter().any(|l| l.iter().any(|x| x.contains(&format!("f_{id}"))));
     if referenced {
         lines.push(format!("variable demx_{id}_n equal $(count(demx_new))"));
@@ -729,9 +797,81 @@ fn pack_once_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &s
     ctx.dropped_fixes.insert(id.to_string());
     ctx.note(
         Severity::Approx,
-        format!("insert/pack once -> create_atoms random + delete_atoms overlap until the count is reached: positions differ, particles exist at once (LIGGGHTS: on the next step), ids are compressed after each pass (delete_atoms), the loop uses `jump SELF` (run the deck with -in FILE)"),
+        "insert/pack once -> create_atoms random + delete_atoms overlap until the count is reached: positions differ, particles exist at once (LIGGGHTS: on the next step), ids are compressed after each pass (delete_atoms), the loop uses `jump SELF` (run the deck with -in FILE)".into(),
     );
     Action::Replace(lines)
+}
+
+/// `insert/pack ... insert_every E` of one sphere size, in a deck whose runs
+/// are constants: a packing pass now (LIGGGHTS inserts on the next step),
+/// and one at every E-th step after, by splitting the runs that follow until
+/// `unfix` (see `split_run`).
+fn pack_every_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &str, seed: &str, diam: f64, dens: f64, w: &[String], every: u64) -> Option<Action> {
+    let now = steps_before(ctx, ctx.pos)?;
+    let k = ctx.inserts_seen;
+    let (mut lines, block) = rsa_setup(ctx, k, region, per_insert, ty, seed, diam, dens, w);
+    lines.insert(0, format!("# demx: {id} = insert/pack every {every} steps -> a random sequential packing pass now and before every {every}th step of the runs below"));
+    let mut sched = InsertSchedule { id: id.to_string(), every, next: now + 1, block, label: format!("demx_rsa{k}"), passes: 0 };
+    lines.extend(sched.pass());
+    ctx.insert_schedules.push(sched);
+    ctx.dropped_fixes.insert(id.to_string());
+    ctx.note(
+        Severity::Approx,
+        format!("insert/pack every {every} steps -> create_atoms random + delete_atoms overlap passes, the runs split at the insertion steps: positions differ, each pass happens after the step before LIGGGHTS' insertion step, thermo prints at the splits"),
+    );
+    Some(Action::Replace(lines))
+}
+
+/// The absolute step at logical line `pos` (the sum of the constant runs
+/// before it); None if a run is not constant or the deck loops before it.
+pub fn steps_before(ctx: &Ctx, pos: usize) -> Option<u64> {
+    let f = ctx.facts;
+    let mut step = 0u64;
+    for w in ctx.all.get(..pos)? {
+        match w.first().map(|s| s.as_str()) {
+            Some("run") => step = run_end(f, w, step)?,
+            Some("jump" | "label" | "next" | "include") => return None,
+            _ => {}
+        }
+    }
+    Some(step)
+}
+
+/// The step a `run N [upto]` ends at, from `step`; None unless N is a constant
+/// and the run has no other keywords.
+fn run_end(f: &Facts, w: &[String], step: u64) -> Option<u64> {
+    let n = f.num(w.get(1)?)?;
+    if n < 0.0 || w.iter().skip(2).any(|x| x != "upto") {
+        return None;
+    }
+    Some(if w.iter().any(|x| x == "upto") { (n as u64).max(step) } else { step + n as u64 })
+}
+
+/// A `run` while repeated insertions are scheduled: split at their steps,
+/// a packing pass at each (None: nothing to split, or the run is not constant).
+pub fn split_run(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if ctx.insert_schedules.is_empty() {
+        return None;
+    }
+    let start = steps_before(ctx, ctx.pos)?;
+    let end = run_end(ctx.facts, w, start)?;
+    let mut out = Vec::new();
+    let mut cur = start;
+    loop {
+        // the earliest pending insertion inside (cur, end]
+        let Some(k) = (0..ctx.insert_schedules.len()).filter(|&k| ctx.insert_schedules[k].next <= end).min_by_key(|&k| ctx.insert_schedules[k].next) else { break };
+        let at = ctx.insert_schedules[k].next;
+        // LIGGGHTS inserts at the start of step `at`: after step at - 1
+        if at > cur + 1 {
+            out.push(format!("run {}", at - 1 - cur));
+            cur = at - 1;
+        }
+        out.extend(ctx.insert_schedules[k].pass());
+    }
+    if end > cur || out.is_empty() {
+        out.push(format!("run {}", end - cur));
+    }
+    Some(Action::Replace(out))
 }
 
 /// What an insert/pack fix fills its region to.
@@ -770,27 +910,11 @@ fn region_volume_expr(f: &Facts, id: &str) -> Option<String> {
 /// first on the step after it is defined, then every `every` steps. None if
 /// a run length is not a constant or the deck loops.
 fn insertions_until_unfix(ctx: &Ctx, id: &str, every: u64) -> Option<u64> {
-    let f = ctx.facts;
-    // absolute step at the fix (runs before it; `upto` runs go to the step)
-    let mut step = 0u64;
-    let run_end = |w: &[String], step: u64| -> Option<u64> {
-        let n = f.num(w.get(1)?)?;
-        if n < 0.0 {
-            return None;
-        }
-        Some(if w.iter().any(|x| x == "upto") { (n as u64).max(step) } else { step + n as u64 })
-    };
-    for w in &ctx.all[..ctx.pos] {
+    let start = steps_before(ctx, ctx.pos)?;
+    let mut step = start;
+    for w in ctx.all.get(ctx.pos + 1..)? {
         match w.first().map(|s| s.as_str()) {
-            Some("run") => step = run_end(w, step)?,
-            Some("jump" | "label" | "next" | "include") => return None,
-            _ => {}
-        }
-    }
-    let start = step;
-    for w in &ctx.all[ctx.pos + 1..] {
-        match w.first().map(|s| s.as_str()) {
-            Some("run") => step = run_end(w, step)?,
+            Some("run") => step = run_end(ctx.facts, w, step)?,
             Some("unfix") if w.get(1).map(|s| s.as_str()) == Some(id) => break,
             Some("jump" | "label" | "next" | "include") => return None,
             _ => {}

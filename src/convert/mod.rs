@@ -122,6 +122,8 @@ pub struct Ctx<'a> {
     /// Lines to emit after the next `run` (e.g. the velocity of particles a
     /// converted insertion put in on that run's first step).
     pub after_run: Vec<String>,
+    /// Repeated insertions emulated by packing passes between split runs.
+    pub insert_schedules: Vec<lammps::InsertSchedule>,
 }
 
 impl<'a> Ctx<'a> {
@@ -132,6 +134,7 @@ impl<'a> Ctx<'a> {
             insert_counts: HashMap::new(),
             inserts_seen: 0,
             after_run: Vec::new(),
+            insert_schedules: Vec::new(),
             facts,
             notes: Vec::new(),
             used_seeds: HashSet::new(),
@@ -270,6 +273,14 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
         "atom_modify" if ctx.facts.has_insertion && w.windows(2).any(|p| p[0] == "map" && p[1] == "array") => {
             ctx.note(Severity::Info, "atom_modify map array -> map hash: LAMMPS 29Sep2021 fix pour segfaults in Atom::map_set with map array (observed)".into());
             Some(Action::Replace(vec![w.iter().map(|x| if x == "array" { "hash" } else { x.as_str() }).collect::<Vec<_>>().join(" ")]))
+        }
+        "run" if !ctx.insert_schedules.is_empty() => lammps::split_run(ctx, w).or_else(|| {
+            ctx.note(Severity::Approx, "this run is not a constant: the repeated insertion is not carried into it".into());
+            None
+        }),
+        "unfix" if w.len() == 2 && ctx.insert_schedules.iter().any(|sc| sc.id == w[1]) => {
+            ctx.insert_schedules.retain(|sc| sc.id != w[1]);
+            Some(Action::Drop("the insertion ends here (its packing passes were placed between the runs above)".into(), Severity::Info))
         }
         "run" if !ctx.after_run.is_empty() => {
             let mut v = vec![w.join(" ")];
