@@ -140,7 +140,7 @@ def heap_case(demx, work, n, nseeds):
         a, ta = run_engine("liggghts", text, work, f"heap_liggghts_{s}", vars_)
         b, tb = run_engine("lmp", lmp_text, work, f"heap_lammps_{s}", vars_)
         j = compare(demx, os.path.join(a, "dump.heap"), os.path.join(b, "dump.heap"), heap=True)
-        ha, hb = j["heap"]
+        ha, hb = j["run"]["heap"]
         res["liggghts"].append(ha)
         res["lammps"].append(hb)
         res["times"]["liggghts"].append(ta)

@@ -309,11 +309,17 @@ pub fn fit_all(runs: &[RunResult], gamma: f64, rho: f64) -> Fits {
     Fits { eq1, eq3, power, eq4 }
 }
 
-/// The `k`-th seed of a sweep: the primes from 15485863 on (LIGGGHTS wants
-/// primes > 10000).
+/// The `k`-th seed of a sweep: `demx compare`'s seeds (primes > 10000, as
+/// LIGGGHTS wants, none equal to a seed the heap deck's templates use:
+/// LIGGGHTS and demx refuse an insertion seed equal to those), then the
+/// primes after the last of them.
 pub fn seed(k: usize) -> i64 {
-    let mut p = 15485863i64;
-    let mut found = 0;
+    let fixed = &super::compare_deck::SEEDS;
+    if let Some(s) = fixed.get(k) {
+        return *s as i64;
+    }
+    let mut p = fixed[fixed.len() - 1] as i64 + 1;
+    let mut found = fixed.len();
     loop {
         if crate::engine::insert::is_prime(p) {
             if found == k {
@@ -637,8 +643,15 @@ mod tests {
     use super::*;
 
     #[test]
-    fn seeds_are_the_primes_from_15485863() {
-        // 15485863 is the 1,000,000th prime; the next are 15485867 and 15485917
-        assert_eq!((seed(0), seed(1), seed(2)), (15485863, 15485867, 15485917));
+    fn seeds_are_primes_that_the_heap_deck_accepts() {
+        // the heap's template (15485867) and distribution (32452843) seeds
+        // must never come up: LIGGGHTS aborts on an insertion seed equal to them
+        let s: Vec<i64> = (0..12).map(seed).collect();
+        assert_eq!(s[0], 15485863);
+        for (k, x) in s.iter().enumerate() {
+            assert!(crate::engine::insert::is_prime(*x) && *x > 10000, "{x}");
+            assert!(*x != 15485867 && *x != 32452843, "{x}");
+            assert!(!s[..k].contains(x), "repeated {x}");
+        }
     }
 }
