@@ -529,6 +529,14 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
             return Some(pack_once_rsa(ctx, id, &region, &n, &ty, &seed, sizes[0].0, dlo, w));
         }
     }
+    // particles per insertion as a number, when everything is a constant
+    let per_insert_now = |t: &PackCount| -> Option<f64> {
+        match t {
+            PackCount::Fraction(fr) => f.num(fr).zip(vol_now).map(|(fr, v)| (fr * v / vp).floor()),
+            PackCount::Particles(n) => f.num(n),
+            PackCount::Mass(m) => f.num(m).map(|m| (m / mp).floor()),
+        }
+    };
     let referenced_later = ctx.all.get(ctx.pos + 1..).unwrap_or(&[]).iter().any(|l| l.iter().any(|x| x.contains(&format!("f_{id}"))));
     let constant_region = f.regions.get(&region).is_some_and(|r| r.args.iter().all(|a| !a.contains('$'))) && !id.contains('$');
     let mut lines = Vec::new();
@@ -551,11 +559,7 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
             ("${demx_npour}".to_string(), fr)
         }
         (Some(t), true) => {
-            let n = match t {
-                PackCount::Fraction(fr) => f.num(fr).zip(vol_now).map(|(fr, v)| (fr * v / vp).floor()),
-                PackCount::Particles(n) => f.num(n),
-                PackCount::Mass(m) => f.num(m).map(|m| (m / mp).floor()),
-            };
+            let n = per_insert_now(t);
             let Some(n) = n else {
                 return Some(Action::Drop("number of particles to insert not known as a constant".into(), Severity::Dropped));
             };
@@ -572,11 +576,7 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
         (Some(t), false) => {
             // refills every E steps while the fix lives: N per insertion x the
             // insertions in the runs that follow until `unfix`
-            let n = match t {
-                PackCount::Fraction(fr) => f.num(fr).zip(vol_now).map(|(fr, v)| (fr * v / vp).floor()),
-                PackCount::Particles(n) => f.num(n),
-                PackCount::Mass(m) => f.num(m).map(|m| (m / mp).floor()),
-            };
+            let n = per_insert_now(t);
             let Some(n) = n else {
                 return Some(Action::Drop("number of particles per insertion not known as a constant".into(), Severity::Dropped));
             };

@@ -76,6 +76,26 @@ pub trait Fix: Send {
     }
 }
 
+/// The deepest surface overlap among the particles of `group`, as
+/// (particle index, overlap / radius): [`Fix::max_surface_overlap`] for a
+/// wall fix that knows each particle's overlap (`overlap(i)`).
+pub fn deepest_overlap(sim: &Sim, group: u32, overlap: impl Fn(usize) -> Option<f64>) -> Option<(usize, f64)> {
+    let p = &sim.particles;
+    let mut worst: Option<(usize, f64)> = None;
+    for i in 0..p.len() {
+        if p.mask[i] & group == 0 {
+            continue;
+        }
+        if let Some(d) = overlap(i) {
+            let f = d / p.radius[i];
+            if worst.is_none_or(|w| f > w.1) {
+                worst = Some((i, f));
+            }
+        }
+    }
+    worst
+}
+
 /// Placeholder put in a fix's slot while its hook runs.
 pub struct Hole;
 impl Fix for Hole {

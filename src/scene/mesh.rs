@@ -412,20 +412,7 @@ impl Fix for WallGranMesh {
         self.summary.clone()
     }
     fn max_surface_overlap(&self, sim: &Sim) -> Option<(usize, f64)> {
-        let p = &sim.particles;
-        let mut worst: Option<(usize, f64)> = None;
-        for i in 0..p.len() {
-            if p.mask[i] & self.group == 0 {
-                continue;
-            }
-            if let Some(d) = self.surface_overlap(sim, i) {
-                let f = d / p.radius[i];
-                if worst.is_none_or(|w| f > w.1) {
-                    worst = Some((i, f));
-                }
-            }
-        }
-        worst
+        crate::engine::fix::deepest_overlap(sim, self.group, |i| self.surface_overlap(sim, i))
     }
     fn surface_overlap(&self, sim: &Sim, i: usize) -> Option<f64> {
         // the deepest triangle contact, read only (no history slots touched)

@@ -119,26 +119,29 @@ impl Fix for WallGran {
         self.summary.clone()
     }
     fn max_surface_overlap(&self, sim: &Sim) -> Option<(usize, f64)> {
-        let p = &sim.particles;
-        let mut worst: Option<(usize, f64)> = None;
-        for i in 0..p.len() {
-            if p.mask[i] & self.group == 0 {
-                continue;
-            }
-            if let Some(d) = self.surface_overlap(sim, i) {
-                let f = d / p.radius[i];
-                if worst.is_none_or(|w| f > w.1) {
-                    worst = Some((i, f));
-                }
-            }
-        }
-        worst
+        crate::engine::fix::deepest_overlap(sim, self.group, |i| self.surface_overlap(sim, i))
     }
     fn surface_overlap(&self, sim: &Sim, i: usize) -> Option<f64> {
         let shift = self.motion.shift(self.wall.axis(), sim.time - self.t0);
         let p = &sim.particles;
         self.wall.contact(p.x[i], p.radius[i], shift).map(|c| c.0).filter(|d| *d > 0.0)
     }
+}
+
+/// The LAMMPS wall geometry (`zplane lo hi`, `zcylinder r`, wiggle/shear)
+/// and the keywords after it.
+fn lammps_wall_geometry(cmd: &Command, a: &mut Args) -> Result<(PrimitiveWall, WallMotion)> {
+    let words = a.rest().to_vec();
+    let (wall, motion, used) = PrimitiveWall::parse_lammps(cmd, &words)?;
+    a.pos += used;
+    while a.more() {
+        let k = a.word("keyword")?;
+        if k.text == "contacts" {
+            continue;
+        }
+        return Err(Error::deck(k.span, format!("fix wall/gran: unknown keyword '{}'", k.text)));
+    }
+    Ok((wall, motion))
 }
 
 /// Parse `fix ID group wall/gran ...` in either dialect.
@@ -227,16 +230,7 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
             }
             "granular" => {
                 let (gspec, table) = granular_coeffs(s, cmd, a, first)?;
-                let words = a.rest().to_vec();
-                let (wall, motion, used) = PrimitiveWall::parse_lammps(cmd, &words)?;
-                a.pos += used;
-                while a.more() {
-                    let k = a.word("keyword")?;
-                    if k.text == "contacts" {
-                        continue;
-                    }
-                    return Err(Error::deck(k.span, format!("fix wall/gran: unknown keyword '{}'", k.text)));
-                }
+                let (wall, motion) = lammps_wall_geometry(cmd, a)?;
                 if matches!(gspec.normal, NormalSpec::GranularCohesive(model::CohesiveNormal::Jkr, _)) {
                     s.notes.push((
                         first.span,
@@ -250,16 +244,7 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
                     .with_hint("LIGGGHTS 2.x `wall/gran/hertz/history` forms are converted by `demx convert`"))
             }
         }
-        let words = a.rest().to_vec();
-        let (wall, motion, used) = PrimitiveWall::parse_lammps(cmd, &words)?;
-        a.pos += used;
-        while a.more() {
-            let k = a.word("keyword")?;
-            if k.text == "contacts" {
-                continue;
-            }
-            return Err(Error::deck(k.span, format!("fix wall/gran: unknown keyword '{}'", k.text)));
-        }
+        let (wall, motion) = lammps_wall_geometry(cmd, a)?;
         spec.has_coeff = true;
         let table = model::fill_table(s, &spec, cmd.span)?;
         (spec, table, 1, wall, motion)
