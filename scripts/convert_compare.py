@@ -50,6 +50,10 @@ CASES = [
         "deck": os.path.join(DEBIAN, "cohesion/in.noCohesion"),
         "dump": "post/dump.coh",
         # the VTK dump as text, the same columns, for both engines
+        "comment": "The insertions match LIGGGHTS (250 per refill; the counts agree in every frame). What differs is the slow "
+        "sliding end of the run: at mu = 0.05 and e = 0.9 the LAMMPS run loses its kinetic energy sooner and ends with more "
+        "contacts, where the two tangential laws differ (LAMMPS caps elastic + damping and rescales the spring, LIGGGHTS "
+        "caps the spring alone and does not damp while sliding). An expected model difference, not a conversion error.",
         "edit": lambda t: re.sub(r"dump\s+dmp all custom/vtk 800 post/noCohesion_\*\.vtk id type type", "dump dmp all custom 800 post/dump.coh id type", t),
     },
 ]
@@ -220,6 +224,8 @@ def main():
         out.append("")
         ta, tb, tc = r["times"]
         out.append(f"Particles at the last frame: LIGGGHTS {r['counts'][0]}, LAMMPS {r['counts'][1]}. Wall time: LIGGGHTS {ta:.0f} s and {tb:.0f} s, LAMMPS {tc:.0f} s. Verdict: **{'PASS' if r['pass'] else 'FAIL'}**.\n")
+        if case.get("comment"):
+            out.append(case["comment"] + "\n")
         print(f"{case['name']}: {'PASS' if r['pass'] else 'FAIL'} ({time.time() - t0:.0f} s)", file=sys.stderr, flush=True)
     out.append("Summary: " + ", ".join(f"{n.split(':')[0]} {'PASS' if v else 'FAIL'}" for n, v in verdicts) + ".\n")
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
