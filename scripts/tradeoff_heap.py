@@ -76,14 +76,22 @@ def table(data, name):
             keep.append((val, r["error"], r["speedup"]))
         for run in r["runs"]:
             if run.get("error"):
-                lines.append(f"| | | failed: {run['error'][:80]} | | | |")
+                err = " ".join(run["error"].split())
+                why = "stopped by the stability guard (exit 1)" if "exit status: 1" in err else err[:80].replace("|", "/")
+                lines.append(f"| | | failed: {why} | | | |")
+    sds = [r["sd"] for r in data["rows"] if r["n"] > 1 and r["sd"] == r["sd"]]
+    resolution = ""
+    if sds:
+        sd = sum(sds) / len(sds)
+        n = max(r["n"] for r in data["rows"])
+        resolution = f" The seeds' SD averages {sd:.2f}°, so a {n}-seed mean carries a standard error of about {sd / n ** 0.5:.2f}° (differences of two of them: {sd * (2 / n) ** 0.5:.2f}°): smaller differences are not resolved."
     if ref is None:
         verdict = "The reference setting failed: no errors."
     elif keep:
         verdict = "Within 1° of the reference: " + ", ".join(f"{name} = {v} (abs(Δθr) = {e:.2f}°, {s:.1f}x faster)" for v, e, s in keep) + "."
     else:
         verdict = "No cheaper setting keeps θr within 1° of the reference."
-    return "\n".join(lines), verdict
+    return "\n".join(lines), verdict + resolution
 
 
 def main():
