@@ -29,11 +29,10 @@ pub struct DemxResult {
     pub wall_seconds: f64,
 }
 
-/// Run `demx run` (the current executable) on `deck_name` inside `dir`.
-pub fn run_demx(dir: &Path, deck_name: &str, vars: &[(String, Vec<String>)], extra: &[String]) -> Result<DemxResult> {
+/// Run the current executable with `args` (then `-var NAME VALUES...` for
+/// each of `vars`) in `dir`: its output and the wall time in seconds.
+pub fn spawn_demx(dir: &Path, args: &mut Vec<String>, vars: &[(String, Vec<String>)]) -> Result<(std::process::Output, f64)> {
     let exe = std::env::current_exe().map_err(|e| Error::io(Span::DUMMY, "cannot find the demx executable", &e))?;
-    let mut args: Vec<String> = vec!["run".into(), "--quiet".into(), "--log".into(), "log.demx".into(), deck_name.into()];
-    args.extend(extra.iter().cloned());
     for (n, v) in vars {
         args.push("-var".into());
         args.push(n.clone());
@@ -41,12 +40,19 @@ pub fn run_demx(dir: &Path, deck_name: &str, vars: &[(String, Vec<String>)], ext
     }
     let t0 = Instant::now();
     let out = Command::new(&exe)
-        .args(&args)
+        .args(args.iter())
         .current_dir(dir)
         .stdin(Stdio::null())
         .output()
         .map_err(|e| Error::io(Span::DUMMY, format!("cannot start '{}'", exe.display()), &e))?;
-    let wall_seconds = t0.elapsed().as_secs_f64();
+    Ok((out, t0.elapsed().as_secs_f64()))
+}
+
+/// Run `demx run` (the current executable) on `deck_name` inside `dir`.
+pub fn run_demx(dir: &Path, deck_name: &str, vars: &[(String, Vec<String>)], extra: &[String]) -> Result<DemxResult> {
+    let mut args: Vec<String> = vec!["run".into(), "--quiet".into(), "--log".into(), "log.demx".into(), deck_name.into()];
+    args.extend(extra.iter().cloned());
+    let (out, wall_seconds) = spawn_demx(dir, &mut args, vars)?;
     let command = format!("demx {}", args.join(" "));
     if !out.status.success() {
         return Err(Error::usage(format!(

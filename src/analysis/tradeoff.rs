@@ -21,8 +21,7 @@ use crate::io::dump::{DumpReader, Frame};
 use crate::script::source::Span;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode, Stdio};
-use std::time::Instant;
+use std::process::ExitCode;
 
 /// The names `--vary` accepts.
 pub const VARY_NAMES: &str = "dt_fraction, youngs_scale, var:NAME";
@@ -486,7 +485,6 @@ fn logged_timestep(dir: &Path) -> Option<f64> {
 
 /// Run `demx run` in `dir`; Ok(wall seconds) or the failure text.
 fn run_one(dir: &Path, deck_name: &str, setting: &[(Param, String)], vars: &[(String, Vec<String>)], threads: usize) -> Result<std::result::Result<f64, String>> {
-    let exe = std::env::current_exe().map_err(|e| Error::io(Span::DUMMY, "cannot find the demx executable", &e))?;
     let mut args: Vec<String> = vec!["run".into(), "--quiet".into(), "--log".into(), "log.demx".into(), "--threads".into(), threads.max(1).to_string()];
     for (p, v) in setting {
         match p {
@@ -503,19 +501,7 @@ fn run_one(dir: &Path, deck_name: &str, setting: &[(Param, String)], vars: &[(St
             all.push((n.clone(), vec![v.clone()]));
         }
     }
-    for (n, v) in &all {
-        args.push("-var".into());
-        args.push(n.clone());
-        args.extend(v.iter().cloned());
-    }
-    let t0 = Instant::now();
-    let out = Command::new(&exe)
-        .args(&args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .output()
-        .map_err(|e| Error::io(Span::DUMMY, format!("cannot start '{}'", exe.display()), &e))?;
-    let wall = t0.elapsed().as_secs_f64();
+    let (out, wall) = super::compare_deck::spawn_demx(dir, &mut args, &all)?;
     if !out.status.success() {
         return Ok(Err(format!("demx run failed ({}): {}", out.status, tail(&String::from_utf8_lossy(&out.stderr), 4).trim())));
     }

@@ -557,32 +557,19 @@ fn write_last_good(sim: &Sim, file: &str) -> std::io::Result<Option<i64>> {
     let s = &sim.guard.snap;
     let p = &sim.particles;
     let arr = |v: &V3| [v.x, v.y, v.z];
+    // one atom of the data file from the columns of the snapshot or the particles
+    #[allow(clippy::too_many_arguments)]
+    fn atom(tag: i64, kind: u32, radius: f64, density: f64, mass: f64, x: [f64; 3], image: [i32; 3], v: [f64; 3], omega: [f64; 3]) -> DataAtom {
+        DataAtom { id: tag.max(0) as u64, kind, diameter: 2.0 * radius, density: if radius > 0.0 { density } else { mass }, x, image, v, omega }
+    }
     let (atoms, lo, hi, step, which): (Vec<DataAtom>, [f64; 3], [f64; 3], i64, Option<i64>) = if s.valid {
         let atoms = (0..s.tag.len())
-            .map(|i| DataAtom {
-                id: s.tag[i].max(0) as u64,
-                kind: s.kind[i],
-                diameter: 2.0 * s.radius[i],
-                density: if s.radius[i] > 0.0 { s.density[i] } else { s.mass[i] },
-                x: arr(&s.x[i]),
-                image: s.image[i],
-                v: arr(&s.v[i]),
-                omega: arr(&s.omega[i]),
-            })
+            .map(|i| atom(s.tag[i], s.kind[i], s.radius[i], s.density[i], s.mass[i], arr(&s.x[i]), s.image[i], arr(&s.v[i]), arr(&s.omega[i])))
             .collect();
         (atoms, s.lo, s.hi, s.step, Some(s.step))
     } else {
         let atoms = (0..p.len())
-            .map(|i| DataAtom {
-                id: p.tag[i].max(0) as u64,
-                kind: p.kind[i],
-                diameter: 2.0 * p.radius[i],
-                density: if p.radius[i] > 0.0 { p.density[i] } else { p.mass[i] },
-                x: arr(&p.x[i]),
-                image: p.image[i],
-                v: arr(&p.v[i]),
-                omega: arr(&p.omega[i]),
-            })
+            .map(|i| atom(p.tag[i], p.kind[i], p.radius[i], p.density[i], p.mass[i], arr(&p.x[i]), p.image[i], arr(&p.v[i]), arr(&p.omega[i])))
             .collect();
         let (lo, hi) = sim.domain.as_ref().map_or(([0.0; 3], [0.0; 3]), |d| (d.lo, d.hi));
         (atoms, lo, hi, sim.step, None)
