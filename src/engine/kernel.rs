@@ -6,13 +6,18 @@
 //! scene is a zero-sized type whose calls compile to nothing, so a scene
 //! without cohesion or rolling pays nothing for them in this loop.
 //!
-//! Determinism: phase 1 computes every pair independently (in parallel), each
-//! writing only its own output slot and history; phase 2 lets every particle
-//! gather its pairs in increasing pair index. The sum order therefore never
-//! depends on the number of threads, and results are bitwise identical for
-//! any thread count.
+//! Determinism: particles are cut into blocks of a fixed size ([`BLOCK`]
+//! particles, contiguous in storage, which the spatial sort makes compact in
+//! space). Phase 1 runs the blocks in parallel: each walks its pairs (those
+//! whose first particle it holds) in increasing index and adds both shares of
+//! a pair at once when both particles are its own, else its own share, keeping
+//! the other for phase 2, in which every particle adds those kept shares in
+//! increasing pair index. The order of additions is fixed by the blocks, never
+//! by the threads, so results are bitwise identical on any thread count.
 
-use super::neighbor::{PairList, ADJ_B};
+use super::neighbor::PairList;
+#[cfg(doc)]
+use super::neighbor::BLOCK;
 use super::particles::Particles;
 use crate::physics::{CohesionLaw, Contact, ContactOut, NormalLaw, PairParams, RollingLaw, TangentialLaw, V3};
 use rayon::prelude::*;
@@ -59,9 +64,6 @@ pub struct Laws<N, T, C, R> {
     pub rolling: R,
 }
 
-/// Output of one pair: force on a, torque on a, torque on b.
-pub type PairOut = [V3; 3];
-
 /// A kernel for one combination of laws (object-safe; one dynamic call per
 /// pass, never per contact).
 pub trait ContactKernel: Send + Sync {
@@ -69,8 +71,10 @@ pub trait ContactKernel: Send + Sync {
     fn history_width(&self) -> usize;
     /// Whether pairs that do not touch interact (non-contact cohesion).
     fn noncontact(&self) -> bool;
-    /// Pair pass: fills `out` (one slot per pair) and updates history.
-    fn pair_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, out: &mut Vec<PairOut>);
+    /// Force pass over the pair list, block by block (see [`Forces`]):
+    /// adds the pairs' forces and torques and updates their history; returns
+    /// the pair virial, the sum of r_ij . F_ij. Follow with [`cross_gather`].
+    fn force_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, force: Forces<'_>) -> f64;
     /// One contact with a wall or any other partner given as a `Contact`;
     /// history is zeroed when apart. Returns the laws' output.
     fn contact(&self, c: &Contact, params: &PairParams, hist: &mut [f64]) -> ContactOut;
@@ -117,7 +121,9 @@ pub fn pair_contact(p: &Particles, i: usize, j: usize, xj: V3, dt: f64) -> Optio
     if r == 0.0 {
         return None;
     }
-    let n = d / r;
+    // unit normal by one reciprocal (as LAMMPS and LIGGGHTS: rinv = 1/r)
+    let rinv = 1.0 / r;
+    let n = d * rinv;
     let delta = radsum - r;
     let mi = if p.frozen[i] { f64::INFINITY } else { p.mass[i] };
     let mj = if p.frozen[j] { f64::INFINITY } else { p.mass[j] };
@@ -164,77 +170,113 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
     fn contact(&self, c: &Contact, params: &PairParams, hist: &mut [f64]) -> ContactOut {
         self.apply(c, params, hist)
     }
-    fn pair_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, out: &mut Vec<PairOut>) {
+    fn force_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, force: Forces<'_>) -> f64 {
         let m = pairs.len();
-        out.clear();
-        out.resize(m, [V3::zeros(); 3]);
         let w = Self::WIDTH;
-        let a = &pairs.a;
-        let b = &pairs.b;
-        let shift = &pairs.shift;
-        let one = |k: usize, slot: &mut PairOut, hist: &mut [f64]| {
-            let i = a[k] as usize;
-            let j = b[k] as usize;
-            let xj = p.x[j] + shift[k];
-            let pp = table.get(p.kind[i], p.kind[j]);
-            // most listed pairs are within the skin but apart: decide on r^2
-            // before building the contact
-            // (a normal law acting beyond touching, JKR, decides itself in
-            // `apply`: its range depends on the radii, not only the types)
-            let beyond = C::NONCONTACT || !N::CONTACT_ONLY;
-            let reach = p.radius[i] + p.radius[j] + if beyond { pp.extra_range } else { 0.0 };
-            if N::CONTACT_ONLY && (p.x[i] - xj).norm_squared() >= reach * reach {
-                hist.fill(0.0);
-                return;
-            }
-            let Some((c, _)) = pair_contact(p, i, j, xj, dt) else { return };
-            if N::CONTACT_ONLY && (c.delta <= -pp.extra_range || (c.delta <= 0.0 && !C::NONCONTACT)) {
-                hist.fill(0.0);
-                return;
-            }
-            let o = self.apply(&c, pp, hist);
-            *slot = [o.force_i(&c), o.torque_i, o.torque_j];
-        };
-        const CHUNK: usize = 1024;
-        if w == 0 {
-            out.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, chunk)| {
-                for (q, slot) in chunk.iter_mut().enumerate() {
-                    one(ci * CHUNK + q, slot, &mut []);
-                }
-            });
-        } else {
-            out.par_chunks_mut(CHUNK).zip(pairs.hist.par_chunks_mut(CHUNK * w)).enumerate().for_each(|(ci, (chunk, hchunk))| {
-                for (q, slot) in chunk.iter_mut().enumerate() {
-                    one(ci * CHUNK + q, slot, &mut hchunk[q * w..(q + 1) * w]);
-                }
-            });
+        let bs = pairs.block_size();
+        let n = p.len();
+        let defer = force.defer;
+        // slots are written before they are read (cross pairs only), so the
+        // buffer is not cleared
+        if defer.len() != m {
+            defer.resize(m, [V3::zeros(); 2]);
         }
+        let PairList { a, b, shift, hist, block_start, .. } = pairs;
+        let (a, b, shift, block_start) = (&a[..], &b[..], &shift[..], &block_start[..]);
+        // split the pairs' history and deferred slots at the block ranges
+        let nblocks = block_start.len().saturating_sub(1);
+        let mut jobs = Vec::with_capacity(nblocks);
+        let (mut hrest, mut drest) = (&mut hist[..], &mut defer[..]);
+        let (mut frest, mut trest) = (&mut force.f[..n], &mut force.torque[..n]);
+        for q in 0..nblocks {
+            let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
+            let (h, hr) = std::mem::take(&mut hrest).split_at_mut((pe - ps) * w);
+            let (d, dr) = std::mem::take(&mut drest).split_at_mut(pe - ps);
+            let len = bs.min(n - (q * bs).min(n));
+            let (f, fr) = std::mem::take(&mut frest).split_at_mut(len);
+            let (tq, tr) = std::mem::take(&mut trest).split_at_mut(len);
+            (hrest, drest, frest, trest) = (hr, dr, fr, tr);
+            jobs.push((q, h, d, f, tq));
+        }
+        let beyond = C::NONCONTACT || !N::CONTACT_ONLY;
+        // one block: its pairs in increasing index; both shares of a pair
+        // inside the block are added at once, the share of a particle of
+        // another block is kept for the cross pass
+        let block = |(q, h, d, f, tq): (usize, &mut [f64], &mut [[V3; 2]], &mut [V3], &mut [V3])| -> f64 {
+            let lo = q * bs;
+            let ps = block_start[q] as usize;
+            let mut virial = 0.0;
+            for k in ps..block_start[q + 1] as usize {
+                let i = a[k] as usize;
+                let j = b[k] as usize;
+                let own_j = j >= lo && j - lo < f.len();
+                if !own_j {
+                    d[k - ps] = [V3::zeros(); 2];
+                }
+                let hk = &mut h[(k - ps) * w..(k - ps + 1) * w];
+                let xj = p.x[j] + shift[k];
+                let pp = table.get(p.kind[i], p.kind[j]);
+                // most listed pairs are within the skin but apart: decide on
+                // r^2 before building the contact (a normal law acting beyond
+                // touching, JKR, decides itself in `apply`)
+                let reach = p.radius[i] + p.radius[j] + if beyond { pp.extra_range } else { 0.0 };
+                if N::CONTACT_ONLY && (p.x[i] - xj).norm_squared() >= reach * reach {
+                    hk.fill(0.0);
+                    continue;
+                }
+                let Some((c, _)) = pair_contact(p, i, j, xj, dt) else { continue };
+                if N::CONTACT_ONLY && (c.delta <= -pp.extra_range || (c.delta <= 0.0 && !C::NONCONTACT)) {
+                    hk.fill(0.0);
+                    continue;
+                }
+                let o = self.apply(&c, pp, hk);
+                let fi = o.force_i(&c);
+                virial += (p.x[i] - xj).dot(&fi);
+                f[i - lo] += fi;
+                tq[i - lo] += o.torque_i;
+                if own_j {
+                    f[j - lo] -= fi;
+                    tq[j - lo] += o.torque_j;
+                } else {
+                    d[k - ps] = [fi, o.torque_j];
+                }
+            }
+            virial
+        };
+        let virials: Vec<f64> = if nblocks > 1 { jobs.into_par_iter().map(block).collect() } else { jobs.into_iter().map(block).collect() };
+        virials.iter().sum()
     }
 }
 
-/// Phase 2: every particle sums its pairs' outputs in increasing pair index
-/// into `f` and `torque` (which the caller has cleared).
-pub fn gather(pairs: &PairList, out: &[PairOut], f: &mut [V3], torque: &mut [V3]) {
-    const CHUNK: usize = 512;
-    f.par_chunks_mut(CHUNK).zip(torque.par_chunks_mut(CHUNK)).enumerate().for_each(|(ci, (fc, tc))| {
+/// Where a force pass adds its forces: `f` and `torque` per particle (which
+/// the caller has cleared or filled with what comes first), and the
+/// deferred shares of cross-block pairs.
+pub struct Forces<'a> {
+    /// Force per particle.
+    pub f: &'a mut [V3],
+    /// Torque per particle.
+    pub torque: &'a mut [V3],
+    /// Per pair: force on `a` and torque on `b`, for pairs whose `b` lies in
+    /// another block (other slots are unused).
+    pub defer: &'a mut Vec<[V3; 2]>,
+}
+
+/// The cross pass: every particle adds the shares of its cross-block pairs
+/// (where it is `b`) in increasing pair index, after its block pass.
+pub fn cross_gather(pairs: &PairList, defer: &[[V3; 2]], f: &mut [V3], torque: &mut [V3]) {
+    if pairs.cross.is_empty() {
+        return;
+    }
+    let bs = pairs.block_size();
+    f.par_chunks_mut(bs).zip(torque.par_chunks_mut(bs)).enumerate().for_each(|(ci, (fc, tc))| {
         for q in 0..fc.len() {
-            let i = ci * CHUNK + q;
-            let (s, e) = (pairs.adj_start[i] as usize, pairs.adj_start[i + 1] as usize);
-            let mut fi = fc[q];
-            let mut ti = tc[q];
-            for &code in &pairs.adj[s..e] {
-                let k = (code & !ADJ_B) as usize;
-                let o = &out[k];
-                if code & ADJ_B == 0 {
-                    fi += o[0];
-                    ti += o[1];
-                } else {
-                    fi -= o[0];
-                    ti += o[2];
-                }
+            let i = ci * bs + q;
+            let (s, e) = (pairs.cross_start[i] as usize, pairs.cross_start[i + 1] as usize);
+            for &k in &pairs.cross[s..e] {
+                let o = &defer[k as usize];
+                fc[q] -= o[0];
+                tc[q] += o[1];
             }
-            fc[q] = fi;
-            tc[q] = ti;
         }
     });
 }
@@ -277,23 +319,32 @@ mod tests {
         let mut table = ParamTable::new(1);
         table.get_mut(1, 1).kn = 100.0;
         let laws = Laws { normal: Spring, tangential: Frictionless, cohesion: NoCohesion, rolling: NoRolling };
-        let run = |threads: usize| {
+        // blocks of 64 particles: 7 blocks, many pairs across blocks
+        let run = |threads: usize, block: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let mut pl = PairList::default();
+                let mut pl = PairList { block, ..Default::default() };
                 pl.build(&p, &dom, &NeighSettings { skin: 0.05, ..Default::default() }, 0, laws.history_width(), |_, _| 0.0);
-                let mut out = vec![];
-                laws.pair_pass(&p, &mut pl, &table, 1e-3, &mut out);
+                let mut defer = vec![];
                 let mut f = vec![V3::zeros(); p.len()];
                 let mut t = vec![V3::zeros(); p.len()];
-                gather(&pl, &out, &mut f, &mut t);
-                (f, pl.hist.clone())
+                let w = laws.force_pass(&p, &mut pl, &table, 1e-3, Forces { f: &mut f, torque: &mut t, defer: &mut defer });
+                cross_gather(&pl, &defer, &mut f, &mut t);
+                assert!(block >= p.len() || !pl.cross.is_empty());
+                (f, pl.hist.clone(), w)
             })
         };
-        let (f1, h1) = run(1);
-        let (f2, h2) = run(2);
+        let (f1, h1, w1) = run(1, 64);
+        let (f2, h2, w2) = run(2, 64);
         assert_eq!(f1, f2);
         assert_eq!(h1, h2);
+        assert_eq!(w1.to_bits(), w2.to_bits());
+        // one block (no cross pairs) gives the same forces up to rounding
+        let (f3, _, w3) = run(2, 4096);
+        for (x, y) in f1.iter().zip(&f3) {
+            assert!((x - y).norm() <= 1e-12 * (1.0 + x.norm()), "{x} vs {y}");
+        }
+        assert!((w1 - w3).abs() <= 1e-12 * w1.abs() && w1 != 0.0);
         let total: V3 = f1.iter().sum();
         assert!(total.norm() < 1e-9, "momentum not conserved: {total}");
         assert!(f1.iter().any(|f| f.norm() > 0.0));

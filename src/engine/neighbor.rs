@@ -12,6 +12,30 @@ use super::domain::Domain;
 use super::particles::Particles;
 use crate::physics::V3;
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A multiply-rotate hasher for id pairs (the history map is rebuilt on every
+/// list build; SipHash's protection against crafted keys is not needed for
+/// particle ids and costs a third of the build).
+#[derive(Default)]
+struct IdHasher(u64);
+
+impl Hasher for IdHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
 
 /// The half pair list with history.
 #[derive(Clone, Debug, Default)]
@@ -42,7 +66,23 @@ pub struct PairList {
     /// Number of dangerous builds (a particle had moved more than half the
     /// skin when the list was rebuilt on schedule).
     pub dangerous: u64,
+    /// Particles per block of the force pass (0: [`BLOCK`]). Pairs are
+    /// sorted by their first particle, so the pairs of one block are a range.
+    pub block: usize,
+    /// Pair index where each block's pairs start (blocks + 1 entries).
+    pub block_start: Vec<u32>,
+    /// CSR offsets into `cross` per particle (len = n + 1).
+    pub cross_start: Vec<u32>,
+    /// For each particle, the pairs where it is `b` and `a` lies in another
+    /// block, in increasing pair index: their share is added after the
+    /// block pass.
+    pub cross: Vec<u32>,
 }
+
+/// Particles per block of the force pass. Fixed, never derived from the
+/// number of threads: the order in which contributions are added to each
+/// particle, and so every bit of the result, is the same on any thread count.
+pub const BLOCK: usize = 2048;
 
 /// Marker bit in `PairList::adj` for "this particle is b".
 pub const ADJ_B: u32 = 1 << 31;
@@ -129,7 +169,7 @@ impl PairList {
     {
         let n = p.len();
         // --- carry old history by id pair
-        let mut old: HashMap<(i64, i64), usize> = HashMap::new();
+        let mut old: HashMap<(i64, i64), usize, BuildHasherDefault<IdHasher>> = HashMap::default();
         if self.width == width && width > 0 {
             for k in 0..self.a.len() {
                 let h = &self.hist[k * width..(k + 1) * width];
@@ -208,7 +248,9 @@ impl PairList {
         // deterministic pair order: by (a, b) storage index, then shift
         let m = self.a.len();
         let mut order: Vec<usize> = (0..m).collect();
-        order.sort_by(|&u, &v| {
+        // (a, b) is unique except for periodic images of one pair: unstable
+        // sorting with the shift as the last key is still deterministic
+        order.sort_unstable_by(|&u, &v| {
             (self.a[u], self.b[u])
                 .cmp(&(self.a[v], self.b[v]))
                 .then_with(|| cmp_v3(&self.shift[u], &self.shift[v]))
@@ -227,6 +269,26 @@ impl PairList {
                 }
             }
         }
+        self.index(n);
+        self.x_built = p.x.clone();
+        self.last_build = step;
+        self.builds += 1;
+    }
+
+    /// Particles per force block.
+    pub fn block_size(&self) -> usize {
+        if self.block == 0 {
+            BLOCK
+        } else {
+            self.block
+        }
+    }
+
+    /// Derived indexes of the pairs `a`, `b` of `n` particles: the adjacency
+    /// of each particle, the pair range of each force block and the cross
+    /// pairs of each particle. Called after every build and after a restart.
+    pub fn index(&mut self, n: usize) {
+        let m = self.a.len();
         // adjacency (CSR), pairs in increasing index per particle
         let mut count = vec![0u32; n + 1];
         for k in 0..m {
@@ -247,9 +309,35 @@ impl PairList {
             fill[b] += 1;
         }
         self.adj_start = count;
-        self.x_built = p.x.clone();
-        self.last_build = step;
-        self.builds += 1;
+        let bs = self.block_size();
+        let nblocks = n.div_ceil(bs).max(1);
+        self.block_start = vec![0; nblocks + 1];
+        for k in 0..m {
+            self.block_start[self.a[k] as usize / bs + 1] += 1;
+        }
+        for q in 0..nblocks {
+            self.block_start[q + 1] += self.block_start[q];
+        }
+        let mut ccount = vec![0u32; n + 1];
+        for k in 0..m {
+            let (a, b) = (self.a[k] as usize, self.b[k] as usize);
+            if a / bs != b / bs {
+                ccount[b + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            ccount[i + 1] += ccount[i];
+        }
+        let mut fill = ccount.clone();
+        self.cross = vec![0; ccount[n] as usize];
+        for k in 0..m {
+            let (a, b) = (self.a[k] as usize, self.b[k] as usize);
+            if a / bs != b / bs {
+                self.cross[fill[b] as usize] = k as u32;
+                fill[b] += 1;
+            }
+        }
+        self.cross_start = ccount;
     }
 
     /// Atom ids were renumbered (`delete_atoms ... compress yes`; `new_id`
@@ -265,6 +353,43 @@ impl PairList {
     pub fn invalidate(&mut self) {
         self.x_built.clear();
     }
+}
+
+/// Storage order that sorts particles by the Morton (Z-order) code of their
+/// bin of size `bin`, ties by current index: neighbours in space become
+/// neighbours in memory, and a contiguous block of particles is a compact
+/// region (few pairs cross blocks).
+pub fn spatial_order(p: &Particles, bin: f64) -> Vec<usize> {
+    let n = p.len();
+    if n == 0 || !(bin > 0.0) {
+        return (0..n).collect();
+    }
+    let mut lo = [f64::INFINITY; 3];
+    for x in &p.x {
+        for d in 0..3 {
+            lo[d] = lo[d].min(x[d]);
+        }
+    }
+    let spread = |v: u64| -> u64 {
+        // 21 bits -> every third bit
+        let mut v = v & 0x1f_ffff;
+        v = (v | v << 32) & 0x1f00000000ffff;
+        v = (v | v << 16) & 0x1f0000ff0000ff;
+        v = (v | v << 8) & 0x100f00f00f00f00f;
+        v = (v | v << 4) & 0x10c30c30c30c30c3;
+        (v | v << 2) & 0x1249249249249249
+    };
+    let mut keys: Vec<(u64, usize)> = (0..n)
+        .map(|i| {
+            let c = |d: usize| -> u64 {
+                let k = ((p.x[i][d] - lo[d]) / bin).floor();
+                if k.is_finite() { k.clamp(0.0, 2097151.0) as u64 } else { 0 }
+            };
+            (spread(c(0)) | spread(c(1)) << 1 | spread(c(2)) << 2, i)
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.into_iter().map(|(_, i)| i).collect()
 }
 
 fn positive(sh: [i64; 3]) -> bool {

@@ -3,7 +3,7 @@
 use super::compute::Compute;
 use super::domain::Domain;
 use super::fix::{Fix, Hole};
-use super::kernel::{gather, ContactKernel, PairOut, ParamTable};
+use super::kernel::{cross_gather, ContactKernel, Forces, ParamTable};
 use super::neighbor::{NeighSettings, PairList};
 use super::output::{Dump, Logger, Thermo};
 use super::particles::Particles;
@@ -47,8 +47,10 @@ pub struct Sim {
     pub neigh: NeighSettings,
     /// Pair list with history.
     pub pairs: PairList,
-    /// Pair outputs of the last force evaluation (virial, per-contact output).
-    pub pair_out: Vec<PairOut>,
+    /// Deferred shares of cross-block pairs (scratch of the force pass).
+    pub pair_defer: Vec<[V3; 2]>,
+    /// Pair virial sum r_ij . F_ij of the last force evaluation.
+    pub pair_virial: f64,
     /// The contact model (None: no pair interactions).
     pub model: Option<PairModel>,
     /// Fixes in definition order.
@@ -91,6 +93,11 @@ pub struct Sim {
     /// saved pair list and forces instead of recomputing them, so it continues
     /// bitwise as the uninterrupted run would have.
     pub resume: bool,
+    /// Sort particles in space every this many steps, at the next rebuild
+    /// (LAMMPS `atom_modify sort`, default 1000; 0: never).
+    pub sort_every: i64,
+    /// Bin size of the sort (0: half the neighbour cutoff, as LAMMPS).
+    pub sort_bin: f64,
     /// Stability guards (`demx_guard`): checks every few steps, last good state.
     pub guard: super::guard::Guard,
 }
@@ -105,7 +112,8 @@ impl Default for Sim {
             groups: vec!["all".into()],
             neigh: NeighSettings::default(),
             pairs: PairList::default(),
-            pair_out: vec![],
+            pair_defer: vec![],
+            pair_virial: 0.0,
             model: None,
             fixes: vec![],
             computes: vec![],
@@ -126,6 +134,8 @@ impl Default for Sim {
             last_rate: 0.0,
             timing: [0.0; 4],
             resume: false,
+            sort_every: 1000,
+            sort_bin: 0.0,
             guard: super::guard::Guard::default(),
         }
     }
@@ -189,6 +199,17 @@ impl Sim {
         let p = &mut self.particles;
         let dom = self.domain.as_mut().ok_or_else(|| Error::runtime("no box"))?;
         dom.shrink_wrap(&p.x);
+        // spatial sort (LAMMPS `Atom::sort`): decided from the step of the
+        // last build, which a restart keeps, so a resumed run sorts when the
+        // uninterrupted one does
+        let every = self.sort_every;
+        if every > 0 && (self.pairs.builds == 0 || self.step.div_euclid(every) > self.pairs.last_build.div_euclid(every)) {
+            let bin = if self.sort_bin > 0.0 { self.sort_bin } else { 0.5 * (2.0 * p.radius.iter().cloned().fold(0.0, f64::max) + self.neigh.skin) };
+            let order = super::neighbor::spatial_order(p, bin);
+            if order.iter().enumerate().any(|(k, &o)| k != o) {
+                p.permute(&order);
+            }
+        }
         let width = self.model.as_ref().map_or(0, |m| m.kernel.history_width());
         let table = self.model.as_ref().map(|m| &m.table);
         let p = &self.particles;
@@ -202,7 +223,7 @@ impl Sim {
             None => {
                 // no pair style: no pairs, but keep the skin bookkeeping
                 self.pairs = PairList { x_built: p.x.clone(), last_build: self.step, ..Default::default() };
-                self.pairs.adj_start = vec![0; p.len() + 1];
+                self.pairs.index(p.len());
             }
         }
         self.force_rebuild = false;
@@ -225,10 +246,15 @@ impl Sim {
         for t in p.torque.iter_mut() {
             *t = V3::zeros();
         }
+        self.pair_virial = 0.0;
         if let Some(m) = &self.model {
-            m.kernel.pair_pass(&self.particles, &mut self.pairs, &m.table, dt, &mut self.pair_out);
             let p = &mut self.particles;
-            gather(&self.pairs, &self.pair_out, &mut p.f, &mut p.torque);
+            let (mut f, mut torque) = (std::mem::take(&mut p.f), std::mem::take(&mut p.torque));
+            let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer };
+            self.pair_virial = m.kernel.force_pass(&self.particles, &mut self.pairs, &m.table, dt, force);
+            cross_gather(&self.pairs, &self.pair_defer, &mut f, &mut torque);
+            let p = &mut self.particles;
+            (p.f, p.torque) = (f, torque);
         }
     }
 
@@ -387,14 +413,7 @@ impl Sim {
 
     /// Pair virial trace sum r_ij . F_ij of the last force evaluation.
     pub fn virial(&self) -> f64 {
-        let p = &self.particles;
-        let mut w = 0.0;
-        for k in 0..self.pair_out.len().min(self.pairs.len()) {
-            let (a, b) = (self.pairs.a[k] as usize, self.pairs.b[k] as usize);
-            let d = p.x[a] - (p.x[b] + self.pairs.shift[k]);
-            w += d.dot(&self.pair_out[k][0]);
-        }
-        w
+        self.pair_virial
     }
 }
 

@@ -108,7 +108,6 @@ const NOOP_COMMANDS: &[&str] = &[
     "package",
     "suffix",
     "balance",
-    "atom_modify",
     "compute_modify",
     "neigh_modify_noop",
     "sort",
@@ -209,6 +208,31 @@ impl Session {
         Ok(())
     }
 
+    /// `atom_modify keyword value ...`: `sort Nfreq binsize` sets the spatial
+    /// sort (0 switches it off); `map`, `first`, `id` change nothing here.
+    fn atom_modify(&mut self, cmd: &Command) -> Result<()> {
+        let mut a = Args::new(cmd);
+        while a.more() {
+            let k = a.word("keyword")?;
+            match k.text.as_str() {
+                "sort" => {
+                    let every = a.i64("sort frequency")?;
+                    let bin = a.f64("sort bin size")?;
+                    if every < 0 || bin < 0.0 {
+                        return Err(Error::deck(k.span, "atom_modify sort: frequency and bin size must be >= 0"));
+                    }
+                    self.sim.sort_every = every;
+                    self.sim.sort_bin = bin;
+                }
+                "map" | "first" | "id" => {
+                    a.word("value")?;
+                }
+                _ => return Err(args::bad_keyword(&k, "atom_modify keyword", &["sort", "map", "first", "id"])),
+            }
+        }
+        Ok(())
+    }
+
     fn dispatch(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
         let name = cmd.name();
         match name {
@@ -229,6 +253,7 @@ impl Session {
                 outputs::execute(self, cmd, vars)
             }
             "run" => self.run_command(cmd, vars),
+            "atom_modify" => self.atom_modify(cmd),
             "demx_guard" => self.guard_command(cmd),
             n if NOOP_COMMANDS.contains(&n) => {
                 if n == "newton" {

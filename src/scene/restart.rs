@@ -233,7 +233,9 @@ impl RestartState {
             last_build: self.last_build,
             builds: self.builds,
             dangerous: 0,
+            ..Default::default()
         };
+        sim.pairs.index(n);
         // continue exactly: the next run reuses the saved list and forces
         sim.force_rebuild = false;
         sim.resume = true;
