@@ -1,89 +1,246 @@
 #!/usr/bin/env python3
-"""Benchmarks demx against the real LIGGGHTS/LAMMPS on the same deck in the same
-run, interleaved, and writes BENCHMARKS.md (median particle-steps/s, ratio, peak
-memory, machine, date, command).
+"""Benchmarks demx against the real LIGGGHTS 3.8 and LAMMPS on the same decks in
+the same run, interleaved, and writes BENCHMARKS.md: median particle-steps/s of
+each program, their ratio, peak memory, where the time goes (each program's own
+section timing), the machine, the date and this command.
 
-Usage: python3 scripts/bench.py [--reps 5] [--threads 1] [--out BENCHMARKS.md]
-Needs `cargo build --release` first.
+Usage: python3 scripts/bench.py [--reps 5] [--only a,b1,...] [--quick]
+Needs `cargo build --release` first; makes its inputs once in target/bench/.
+
+Decks (bench/ and ../shared/bench/chute, as the performance issue lists them):
+  a   settled bed of 30,000 Hertz spheres, tangential history (LIGGGHTS dialect);
+      one thread vs one rank, and two threads vs `mpirun -np 2`
+  b1  the same bed with rolling friction epsd2;  b2  with cohesion sjkr
+  c   the LAMMPS chute-flow benchmark (gran/hooke/history, 32,000 particles)
+  d   the stock heap template at d = 1 mm and full glass stiffness (Y = 63 GPa),
+      the first chunks of the pour
+  e   scaling: the bed tiled from 7,500 to 1,080,000 particles (demx alone)
+The bed is made by bench/in.bed_prepare.liggghts (7,500 spheres settled in a
+20 x 20 mm periodic box) and tiled in x and y.
 """
-import argparse, datetime, os, re, shutil, statistics, subprocess, tempfile
+import argparse, datetime, os, re, shutil, statistics, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEMX = os.path.join(ROOT, "target", "release", "demx")
-
-# (name, deck, engine, steps-per-run detector)
-CASES = [
-    ("settle-1000 (LIGGGHTS hertz + history, 1,000 spheres, 8,000 steps)", "templates/settle/in.settle.liggghts", "liggghts"),
-    ("settle-1000 (LAMMPS gran/hertz/history, 1,000 spheres, 8,000 steps)", "templates/settle/in.settle.lammps", "lammps"),
-]
+WORK = os.path.join(ROOT, "target", "bench")
+CHUTE = os.path.join(os.path.dirname(ROOT), "shared", "bench", "chute")
+PROFILE_BEGIN, PROFILE_END = "<!-- bench:begin (scripts/bench.py) -->", "<!-- bench:end -->"
 
 
-def strip_dumps(src, dst):
-    with open(src) as f, open(dst, "w") as g:
-        for line in f:
-            w = line.split()
-            g.write(("# " + line) if w and w[0] in ("dump", "dump_modify") else line)
-
-
-def timed(cmd, cwd):
-    p = subprocess.run(["/usr/bin/time", "-f", "MAXRSS %M"] + cmd, cwd=cwd, capture_output=True, text=True)
+def run(cmd, cwd, env=None):
+    p = subprocess.run(["/usr/bin/time", "-f", "MAXRSS %M"] + cmd, cwd=cwd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
-        raise RuntimeError(f"{cmd} failed: {p.stderr[-500:]}")
+        raise RuntimeError(f"{' '.join(cmd)} failed in {cwd}:\n{p.stdout[-1500:]}\n{p.stderr[-1500:]}")
     rss = int(re.search(r"MAXRSS (\d+)", p.stderr).group(1))
     return p.stdout, rss
 
 
-def loop_time(text):
-    m = re.search(r"Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps with (\d+) atoms", text)
-    return float(m.group(1)), int(m.group(2)), int(m.group(3))
+def loops(text):
+    """All runs of a log: (loop seconds, steps, atoms) per `Loop time` line."""
+    return [(float(t), int(n), int(a)) for t, n, a in
+            re.findall(r"Loop time of ([0-9.eE+-]+) on \d+ procs(?: \(\d+ threads\))? for (\d+) steps with (\d+) atoms", text)]
+
+
+def sections(text, engine):
+    """Seconds per section of the last run, as the program prints them."""
+    out = {}
+    if engine == "demx":
+        for name, t in re.findall(r"^(Pair|Neigh|Modify|Output)\s*\|\s*([0-9.eE+-]+)", text, re.M):
+            out[name] = out.get(name, 0.0) + float(t)
+    else:
+        # LIGGGHTS: "Pair  time (%) = 7.73 (88.8)"; LAMMPS: "Pair    | 1.23 | 1.23 | 1.23 | 0.0 | 88.8"
+        for name, t in re.findall(r"^(Pair|Neigh|Comm|Output|Outpt|Modify|Other)\s+time \(%\) = ([0-9.eE+-]+)", text, re.M):
+            out[name] = out.get(name, 0.0) + float(t)
+        for name, t in re.findall(r"^(Pair|Neigh|Comm|Output|Modify|Other)\s*\|\s*([0-9.eE+-]+)", text, re.M):
+            out[name] = out.get(name, 0.0) + float(t)
+    return out
+
+
+def rate(text):
+    ls = loops(text)
+    secs = sum(t for t, _, _ in ls)
+    psteps = sum(n * a for _, n, a in ls)
+    return psteps / secs, psteps, secs
+
+
+def prepare(quick):
+    os.makedirs(WORK, exist_ok=True)
+    bed = os.path.join(WORK, "bed.data")
+    if not os.path.exists(bed):
+        print("preparing the bed (7,500 spheres settling, a few minutes)", flush=True)
+        run([DEMX, "run", os.path.join(ROOT, "bench", "in.bed_prepare.liggghts"), "-var", "out", "bed.data.tmp", "--log", "none"], WORK)
+        os.replace(os.path.join(WORK, "bed.data.tmp"), bed)
+    tiles = [1, 2] if quick else [1, 2, 4, 8, 12]
+    for k in tiles:
+        out = os.path.join(WORK, f"bed{k}x{k}.data")
+        if not os.path.exists(out):
+            tile_data(bed, out, k, k)
+    chute = os.path.join(WORK, "data.chute")
+    if not os.path.exists(chute):
+        print("preparing data.chute (LAMMPS settles the generated lattice, about a minute)", flush=True)
+        subprocess.run([sys.executable, os.path.join(CHUTE, "gen_chute_init.py")], cwd=WORK, check=True, capture_output=True)
+        run(["lmp", "-in", os.path.join(CHUTE, "settle_chute.lmp"), "-log", "none"], WORK)
+    return bed
+
+
+def tile_data(src, dst, nx, ny):
+    """Copies of a periodic bed side by side in x and y (ids renumbered)."""
+    box, atoms, vel, sec = {}, [], {}, None
+    for line in open(src):
+        w = line.split()
+        if len(w) == 4 and w[2] in ("xlo", "ylo", "zlo"):
+            box[w[2][0]] = (float(w[0]), float(w[1]))
+        elif w and w[0] in ("Atoms", "Velocities"):
+            sec = w[0]
+        elif sec == "Atoms" and len(w) >= 7:
+            atoms.append(w)
+        elif sec == "Velocities" and len(w) >= 7:
+            vel[w[0]] = w[1:7]
+    lx, ly = box["x"][1] - box["x"][0], box["y"][1] - box["y"][0]
+    n = len(atoms) * nx * ny
+    head = [f"bench bed tiled {nx} x {ny} (scripts/bench.py)", "", f"{n} atoms", "1 atom types", "",
+            f"{box['x'][0]!r} {box['x'][0] + nx * lx!r} xlo xhi", f"{box['y'][0]!r} {box['y'][0] + ny * ly!r} ylo yhi",
+            f"{box['z'][0]!r} {box['z'][1]!r} zlo zhi", "", "Atoms", ""]
+    body, vbody, t = [], ["", "Velocities", ""], 0
+    for i in range(nx):
+        for j in range(ny):
+            for w in atoms:
+                t += 1
+                body.append(f"{t} {w[1]} {w[2]} {w[3]} {float(w[4]) + i * lx!r} {float(w[5]) + j * ly!r} {w[6]}")
+                vbody.append(f"{t} " + " ".join(vel.get(w[0], ["0"] * 6)))
+    with open(dst + ".tmp", "w") as f:
+        f.write("\n".join(head + body + vbody) + "\n")
+    os.replace(dst + ".tmp", dst)
+
+
+def demx_cmd(deck, threads, var):
+    cmd = [DEMX, "run", deck, "--log", "none", "--threads", str(threads)]
+    for k, v in var.items():
+        cmd += ["-var", k, str(v)]
+    return cmd
+
+
+def engine_cmd(engine, deck, ranks, var):
+    exe = {"liggghts": "liggghts", "lammps": "lmp"}[engine]
+    cmd = ([] if ranks == 1 else ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)]) + [exe, "-in", deck, "-log", "none"]
+    for k, v in var.items():
+        cmd += ["-var", k, str(v)]
+    return cmd
+
+
+def case(name, deck, engine, var, reps, threads=1, ranks=1, engine_deck=None):
+    """Interleaved runs of demx and the engine; medians."""
+    d_ps, e_ps, d_rss, e_rss, d_sec, e_sec = [], [], [], [], [], []
+    for _ in range(reps):
+        out, rss = run(demx_cmd(deck, threads, var), WORK)
+        d_ps.append(rate(out)[0]); d_rss.append(rss); d_sec.append(sections(out, "demx"))
+        if engine:
+            out, rss = run(engine_cmd(engine, engine_deck or deck, ranks, var), WORK)
+            e_ps.append(rate(out)[0]); e_rss.append(rss); e_sec.append(sections(out, engine))
+    md = statistics.median(d_ps)
+    me = statistics.median(e_ps) if e_ps else None
+    row = dict(name=name, demx=md, engine=me, eng=engine, ranks=ranks, threads=threads, drss=max(d_rss),
+               erss=max(e_rss) if e_rss else None, dsec=d_sec[len(d_sec) // 2], esec=e_sec[len(e_sec) // 2] if e_sec else None,
+               atoms=loops(out)[-1][2] if loops(out) else 0)
+    ratio = f", ratio {md / me:.2f}" if me else ""
+    print(f"{name}: demx {md:.3e}" + (f", {engine} {me:.3e}" if me else "") + ratio, flush=True)
+    return row
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--reps", type=int, default=5)
-    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--only", default="a,a2,b1,b2,c,d,e")
+    ap.add_argument("--quick", action="store_true", help="small beds and few steps (checks the harness)")
     ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
     a = ap.parse_args()
+    only = a.only.split(",")
+    prepare(a.quick)
+    bench = lambda f: os.path.join(ROOT, "bench", f)
+    big = "bed1x1.data" if a.quick else "bed2x2.data"
+    steps = 100 if a.quick else 1000
+    rows = []
+    if "a" in only:
+        rows.append(case("(a) bed, Hertz + history, 30,000 spheres, 1 thread / 1 rank", bench("in.bed.liggghts"), "liggghts",
+                         dict(data=big, nsteps=steps), a.reps))
+    if "a2" in only:
+        rows.append(case("(a) bed, 2 threads / `mpirun -np 2`", bench("in.bed.liggghts"), "liggghts",
+                         dict(data=big, nsteps=steps), a.reps, threads=2, ranks=2))
+    if "b1" in only:
+        rows.append(case("(b1) bed + rolling friction epsd2", bench("in.bed_rolling.liggghts"), "liggghts",
+                         dict(data=big, nsteps=steps), a.reps))
+    if "b2" in only:
+        rows.append(case("(b2) bed + cohesion sjkr", bench("in.bed_cohesion.liggghts"), "liggghts",
+                         dict(data=big, nsteps=steps), a.reps))
+    if "c" in only:
+        chute = os.path.join(CHUTE, "in.chute")
+        rows.append(case("(c) LAMMPS chute benchmark, gran/hooke/history, 32,000 particles", chute, "lammps",
+                         dict(nsteps=steps * 2), a.reps))
+        rows.append(case("(c) chute, LIGGGHTS translation (in.chute.liggghts)", os.path.join(CHUTE, "in.chute.liggghts"), "liggghts",
+                         dict(nsteps=steps * 2), a.reps))
+    if "d" in only:
+        rows.append(case("(d) stock heap, d = 1 mm, Y = 63 GPa, first chunks of the pour (N = 300)",
+                         os.path.join(ROOT, "templates", "heap", "in.heap"), "liggghts",
+                         dict(model="stock", Y="6.3e10", N=100 if a.quick else 300, relax=1), max(3, a.reps // 2) if not a.quick else 1))
+    scaling = []
+    if "e" in only:
+        for k in ([1, 2] if a.quick else [1, 2, 4, 8, 12]):
+            n = 7500 * k * k
+            nsteps = max(20, int((2e5 if a.quick else 4e7) / n))
+            r = case(f"(e) bed {n:,} spheres", bench("in.bed.liggghts"), None, dict(data=f"bed{k}x{k}.data", nsteps=nsteps),
+                     1 if a.quick else 3)
+            r["n"], r["steps"] = n, nsteps
+            scaling.append(r)
+    write(a, rows, scaling)
+
+
+def fmt_sec(s, total_keys):
+    if not s:
+        return ""
+    tot = sum(s.values()) or 1.0
+    return ", ".join(f"{k} {100 * s[k] / tot:.0f}%" for k in total_keys if k in s)
+
+
+def write(a, rows, scaling):
     cpu = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
     model = next((l.split(":", 1)[1].strip() for l in cpu.splitlines() if l.startswith("Model name")), "unknown")
-    cores = os.cpu_count()
-    rows = []
-    for name, deck, engine in CASES:
-        with tempfile.TemporaryDirectory() as tmp:
-            d = os.path.join(tmp, "in.bench")
-            strip_dumps(os.path.join(ROOT, deck), d)
-            demx_ps, eng_ps, demx_rss, eng_rss = [], [], [], []
-            for _ in range(a.reps):
-                out, rss = timed([DEMX, "run", d, "--log", "none", "--threads", str(a.threads)], tmp)
-                t, n, at = loop_time(out)
-                demx_ps.append(n * at / t); demx_rss.append(rss)
-                exe = ["liggghts", "-in", d, "-log", "none"] if engine == "liggghts" else ["lmp", "-in", d, "-log", "none"]
-                out, rss = timed(exe, tmp)
-                t, n, at = loop_time(out)
-                eng_ps.append(n * at / t); eng_rss.append(rss)
-            md, me = statistics.median(demx_ps), statistics.median(eng_ps)
-            rows.append((name, md, me, md / me, max(demx_rss), max(eng_rss), engine))
-            print(f"{name}: demx {md:.3e}, {engine} {me:.3e}, ratio {md / me:.2f}")
-    # sections written by other scripts (<!-- NAME:begin ... --> ... <!-- NAME:end -->) are kept
-    kept = ""
-    if os.path.exists(a.out):
-        old = open(a.out).read()
-        for m in re.finditer(r"<!-- (\w+):begin.*?<!-- \1:end -->", old, re.S):
-            kept += "\n" + m.group(0) + "\n"
-    with open(a.out, "w") as f:
-        f.write("# Benchmarks\n\nGenerated by `python3 scripts/bench.py" + (f" --threads {a.threads}" if a.threads != 1 else "")
-                + f"` (after `cargo build --release`) on {datetime.date.today()}, {model}, {cores} cores.\n")
-        f.write(f"Each case runs demx and the engine on the same deck (dumps removed), interleaved, {a.reps} times each; the figures\n")
-        f.write("are medians of particle-steps per second from each program's own loop time (the engine's `Loop time`, demx's\n")
-        f.write(f"`Loop time` line), so start-up is excluded. demx ran with --threads {a.threads}; the engines on one MPI rank. Peak memory\n")
-        f.write("is the maximum resident set size of the whole process (`/usr/bin/time -f %M`).\n\n")
-        f.write("| case | demx (particle-steps/s) | engine (particle-steps/s) | ratio demx/engine | demx peak RSS (MB) | engine peak RSS (MB) |\n")
-        f.write("| --- | --- | --- | --- | --- | --- |\n")
-        for name, md, me, r, dr, er, eng in rows:
-            f.write(f"| {name} | {md:.3e} | {me:.3e} ({eng}) | {r:.2f} | {dr / 1024:.1f} | {er / 1024:.1f} |\n")
-        f.write("\nThese decks are small (1,000 particles); the performance issue's benchmark decks (30,000-sphere beds, the\n")
-        f.write("LAMMPS chute benchmark, 10^6-particle scaling) are not in this table yet.\n")
-        f.write(kept)
+    cmd = "python3 scripts/bench.py" + "".join(f" {x}" for x in sys.argv[1:])
+    lines = [PROFILE_BEGIN, "",
+             f"Generated by `{cmd}` (after `cargo build --release`) on {datetime.date.today()}, {model}, {os.cpu_count()} cores.",
+             f"Each case runs demx and the engine on the same deck, interleaved, {a.reps} times each (the heap 3 times, the",
+             "scaling rows 3 times, demx alone); figures are medians of particle-steps per second from each program's own",
+             "`Loop time` lines (summed over the runs of a deck), so start-up is excluded. Peak memory is the maximum resident",
+             "set size of the whole process (`/usr/bin/time -f %M`).", "",
+             "| case | demx (particle-steps/s) | engine (particle-steps/s) | ratio demx/engine | peak RSS demx / engine (MB) |",
+             "| --- | --- | --- | --- | --- |"]
+    for r in rows:
+        eng = f"{r['engine']:.3e} ({r['eng']}{', ' + str(r['ranks']) + ' ranks' if r['ranks'] > 1 else ', 1 rank'})" if r["engine"] else "-"
+        ratio = f"{r['demx'] / r['engine']:.2f}" if r["engine"] else "-"
+        rss = f"{r['drss'] / 1024:.0f} / {r['erss'] / 1024:.0f}" if r["erss"] else f"{r['drss'] / 1024:.0f}"
+        lines.append(f"| {r['name']} (demx --threads {r['threads']}) | {r['demx']:.3e} | {eng} | {ratio} | {rss} |")
+    lines += ["", "Where the time goes (the median run's section timing, as each program prints it):", "",
+              "| case | demx | engine |", "| --- | --- | --- |"]
+    for r in rows:
+        lines.append(f"| {r['name']} | {fmt_sec(r['dsec'], ['Pair', 'Neigh', 'Modify', 'Output'])} | "
+                     f"{fmt_sec(r['esec'], ['Pair', 'Neigh', 'Comm', 'Modify', 'Outpt', 'Output', 'Other'])} |")
+    if scaling:
+        base = scaling[0]["demx"]
+        lines += ["", "Scaling (demx, one thread; the bed tiled in x and y):", "",
+                  "| particles | steps | particle-steps/s | relative to the smallest | peak RSS (MB) | bytes per particle |",
+                  "| --- | --- | --- | --- | --- | --- |"]
+        for r in scaling:
+            lines.append(f"| {r['n']:,} | {r['steps']} | {r['demx']:.3e} | {r['demx'] / base:.2f} | {r['drss'] / 1024:.0f} | "
+                         f"{r['drss'] * 1024 / r['n']:.0f} |")
+    lines += ["", PROFILE_END]
+    block = "\n".join(lines)
+    old = open(a.out).read() if os.path.exists(a.out) else "# Benchmarks\n"
+    if PROFILE_BEGIN in old:
+        new = re.sub(re.escape(PROFILE_BEGIN) + r".*?" + re.escape(PROFILE_END), lambda _: block, old, flags=re.S)
+    else:
+        new = old.rstrip() + "\n\n" + block + "\n"
+    with open(a.out + ".tmp", "w") as f:
+        f.write(new)
+    os.replace(a.out + ".tmp", a.out)
     print("wrote", a.out)
 
 
