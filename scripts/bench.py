@@ -161,7 +161,7 @@ def main():
     steps = 100 if a.quick else 1000
     rows = []
     if "a" in only:
-        rows.append(case("(a) bed, Hertz + history, 30,000 spheres, 1 thread / 1 rank", bench("in.bed.liggghts"), "liggghts",
+        rows.append(case("(a) settled bed, Hertz + history, 1 thread / 1 rank", bench("in.bed.liggghts"), "liggghts",
                          dict(data=big, nsteps=steps), a.reps))
     if "a2" in only:
         rows.append(case("(a) bed, 2 threads / `mpirun -np 2`", bench("in.bed.liggghts"), "liggghts",
@@ -174,19 +174,19 @@ def main():
                          dict(data=big, nsteps=steps), a.reps))
     if "c" in only:
         chute = os.path.join(CHUTE, "in.chute")
-        rows.append(case("(c) LAMMPS chute benchmark, gran/hooke/history, 32,000 particles", chute, "lammps",
+        rows.append(case("(c) LAMMPS chute benchmark, gran/hooke/history", chute, "lammps",
                          dict(nsteps=steps * 2), a.reps))
         rows.append(case("(c) chute, LIGGGHTS translation (in.chute.liggghts)", os.path.join(CHUTE, "in.chute.liggghts"), "liggghts",
                          dict(nsteps=steps * 2), a.reps))
     if "d" in only:
-        rows.append(case("(d) stock heap, d = 1 mm, Y = 63 GPa, first chunks of the pour (N = 300)",
+        rows.append(case("(d) stock heap, d = 1 mm, Y = 63 GPa, first chunks of the pour",
                          os.path.join(ROOT, "templates", "heap", "in.heap"), "liggghts",
                          dict(model="stock", Y="6.3e10", N=100 if a.quick else 300, relax=1), max(3, a.reps // 2) if not a.quick else 1))
     scaling = []
     if "e" in only:
         for k in ([1, 2] if a.quick else [1, 2, 4, 8, 12]):
             n = 7500 * k * k
-            nsteps = max(20, int((2e5 if a.quick else 4e7) / n))
+            nsteps = max(20 if a.quick else 100, int((2e5 if a.quick else 4e7) / n))
             r = case(f"(e) bed {n:,} spheres", bench("in.bed.liggghts"), None, dict(data=f"bed{k}x{k}.data", nsteps=nsteps),
                      1 if a.quick else 3)
             r["n"], r["steps"] = n, nsteps
@@ -211,13 +211,13 @@ def write(a, rows, scaling):
              "scaling rows 3 times, demx alone); figures are medians of particle-steps per second from each program's own",
              "`Loop time` lines (summed over the runs of a deck), so start-up is excluded. Peak memory is the maximum resident",
              "set size of the whole process (`/usr/bin/time -f %M`).", "",
-             "| case | demx (particle-steps/s) | engine (particle-steps/s) | ratio demx/engine | peak RSS demx / engine (MB) |",
-             "| --- | --- | --- | --- | --- |"]
+             "| case | particles (end) | demx (particle-steps/s) | engine (particle-steps/s) | ratio demx/engine | peak RSS demx / engine (MB) |",
+             "| --- | --- | --- | --- | --- | --- |"]
     for r in rows:
         eng = f"{r['engine']:.3e} ({r['eng']}{', ' + str(r['ranks']) + ' ranks' if r['ranks'] > 1 else ', 1 rank'})" if r["engine"] else "-"
         ratio = f"{r['demx'] / r['engine']:.2f}" if r["engine"] else "-"
         rss = f"{r['drss'] / 1024:.0f} / {r['erss'] / 1024:.0f}" if r["erss"] else f"{r['drss'] / 1024:.0f}"
-        lines.append(f"| {r['name']} (demx --threads {r['threads']}) | {r['demx']:.3e} | {eng} | {ratio} | {rss} |")
+        lines.append(f"| {r['name']} (demx --threads {r['threads']}) | {r['atoms']:,} | {r['demx']:.3e} | {eng} | {ratio} | {rss} |")
     lines += ["", "Where the time goes (the median run's section timing, as each program prints it):", "",
               "| case | demx | engine |", "| --- | --- | --- |"]
     for r in rows:

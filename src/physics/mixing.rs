@@ -454,7 +454,7 @@ pub fn mp_beta(e: f64, v_ref: f64, exact: bool) -> Option<f64> {
 
 /// Dissipative constant A_n = 2 beta / (3 (k_n/m*)^{2/5}) of the paper's
 /// Eq. 10 for a pair with k_n (N/m^{3/2}) and m* (0 for infinite m*).
-#[inline]
+#[inline(always)]
 pub fn viscoelastic_a_n(beta: f64, k_n: f64, m_eff: f64) -> f64 {
     if !(m_eff > 0.0 && m_eff.is_finite() && k_n > 0.0) {
         return 0.0;

@@ -17,7 +17,7 @@ pub struct LiggghtsSjkr {
 impl CohesionLaw for LiggghtsSjkr {
     const HISTORY: usize = 0;
     const NONCONTACT: bool = false;
-    #[inline]
+    #[inline(always)]
     fn cohesion(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let d = c.r;
         let a_cont = if c.is_wall() {

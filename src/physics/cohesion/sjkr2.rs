@@ -14,7 +14,7 @@ pub struct LiggghtsSjkr2 {
 impl CohesionLaw for LiggghtsSjkr2 {
     const HISTORY: usize = 0;
     const NONCONTACT: bool = false;
-    #[inline]
+    #[inline(always)]
     fn cohesion(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let two_pi = 2.0 * std::f64::consts::PI;
         let a_cont = if c.is_wall() { two_pi * c.ri * c.delta } else { two_pi * (2.0 * c.r_eff) * c.delta };

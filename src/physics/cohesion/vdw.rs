@@ -23,7 +23,7 @@ pub struct Hamaker;
 impl CohesionLaw for Hamaker {
     const HISTORY: usize = 0;
     const NONCONTACT: bool = true;
-    #[inline]
+    #[inline(always)]
     fn cohesion(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         if c.is_wall() {
             return;

@@ -18,7 +18,7 @@ pub struct LammpsGranHooke;
 
 impl NormalLaw for LammpsGranHooke {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let gamma_n = c.m_eff * p.gamma_n;
         super::store_normal(out, p.kn * c.delta, -gamma_n * c.vn, p.limit_damping);
@@ -38,7 +38,7 @@ pub struct LammpsGranHertz;
 
 impl NormalLaw for LammpsGranHertz {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let polyhertz = (c.delta * c.r_eff).sqrt();
         let gamma_n = polyhertz * c.m_eff * p.gamma_n;

@@ -49,7 +49,7 @@ pub struct LammpsGranular {
 
 impl NormalLaw for LammpsGranular {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let delta_n = c.delta;
         let a = (delta_n * c.r_eff).sqrt();

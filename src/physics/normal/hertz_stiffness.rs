@@ -13,7 +13,7 @@ pub struct LiggghtsHertzStiffness;
 
 impl NormalLaw for LiggghtsHertzStiffness {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let delta_n = c.delta;
         let s = (c.r_eff * delta_n).sqrt();

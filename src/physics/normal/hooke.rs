@@ -20,7 +20,7 @@ pub struct LiggghtsHooke {
 
 /// LIGGGHTS hooke stiffness k_n from Y*, R*, m* and the characteristic
 /// velocity V (doc `gran_model_hooke.txt`).
-#[inline]
+#[inline(always)]
 pub fn liggghts_hooke_kn(y_eff: f64, r_eff: f64, m_eff: f64, char_vel: f64) -> f64 {
     let sqrt_r = r_eff.sqrt();
     16.0 / 15.0 * sqrt_r * y_eff * (15.0 * m_eff * char_vel * char_vel / (16.0 * sqrt_r * y_eff)).powf(0.2)
@@ -28,7 +28,7 @@ pub fn liggghts_hooke_kn(y_eff: f64, r_eff: f64, m_eff: f64, char_vel: f64) -> f
 
 impl NormalLaw for LiggghtsHooke {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let delta_n = c.delta;
         let k_n = liggghts_hooke_kn(p.y_eff, c.r_eff, c.m_eff, p.char_vel);

@@ -16,7 +16,7 @@ pub struct LiggghtsHookeStiffness {
 
 impl NormalLaw for LiggghtsHookeStiffness {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let delta_n = c.delta;
         let scale = if self.absolute_damping { 1.0 } else { c.m_eff };

@@ -108,11 +108,11 @@ pub struct LammpsJkr {
 impl NormalLaw for LammpsJkr {
     const HISTORY: usize = 1;
     const CONTACT_ONLY: bool = false;
-    #[inline]
+    #[inline(always)]
     fn active(&self, c: &Contact, p: &PairParams, hist: &[f64]) -> bool {
         c.delta > 0.0 || (hist[0] != 0.0 && c.delta > jkr_pulloff_overlap(c.r_eff, p.y_eff, p.cohesion))
     }
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         hist[0] = 1.0;
         let e = p.y_eff;

@@ -32,7 +32,7 @@ pub struct PaperViscoelastic;
 
 impl NormalLaw for PaperViscoelastic {
     const HISTORY: usize = 1;
-    #[inline]
+    #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let sqrt_r = c.r_eff.sqrt();
         // Eq. 12

@@ -11,7 +11,7 @@ pub struct LiggghtsCdt;
 
 impl RollingLaw for LiggghtsCdt {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let (w, lever) = if c.is_wall() { (c.wi, c.ri - 0.5 * c.delta) } else { (c.wi - c.wj, c.r_eff) };
         let w_mag = w.norm();

@@ -17,7 +17,7 @@ pub struct LiggghtsEpsd {
 
 impl RollingLaw for LiggghtsEpsd {
     const HISTORY: usize = 3;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (w, r) = liggghts_rotation(c);
         let k_r = 2.25 * out.kn * p.mu_r * p.mu_r * r * r;

@@ -14,7 +14,7 @@ pub struct LiggghtsEpsd2 {
 
 impl RollingLaw for LiggghtsEpsd2 {
     const HISTORY: usize = 3;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (w, r) = liggghts_rotation(c);
         let k_r = out.kt * r * r;

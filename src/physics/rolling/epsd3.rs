@@ -15,7 +15,7 @@ pub struct LiggghtsEpsd3 {
 
 impl RollingLaw for LiggghtsEpsd3 {
     const HISTORY: usize = 3;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (w, r) = liggghts_rotation(c);
         let k_r = p.k_r_coeff * out.kn * p.mu_r * p.mu_r * r * r;

@@ -58,7 +58,7 @@ pub struct LammpsTwistMarshall;
 
 impl RollingLaw for LammpsTwistMarshall {
     const HISTORY: usize = 1;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         twist(c, p, &mut hist[0], out);
     }
@@ -72,7 +72,7 @@ pub struct LammpsSdsMarshall;
 
 impl RollingLaw for LammpsSdsMarshall {
     const HISTORY: usize = <LammpsSds as RollingLaw>::HISTORY + 1;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (hr, ht) = hist.split_at_mut(<LammpsSds as RollingLaw>::HISTORY);
         LammpsSds { twisting: false }.rolling(c, p, hr, out);

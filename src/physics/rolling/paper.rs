@@ -25,7 +25,7 @@ pub struct PaperEpsd {
 
 impl RollingLaw for PaperEpsd {
     const HISTORY: usize = 3;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let w = if c.is_wall() { c.wi } else { c.wi - c.wj };
         let r = c.r_eff;

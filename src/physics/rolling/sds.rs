@@ -26,7 +26,7 @@ pub struct LammpsSds {
 
 impl RollingLaw for LammpsSds {
     const HISTORY: usize = 4;
-    #[inline]
+    #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let relrot = if c.is_wall() { c.wi } else { c.wi - c.wj };
         let f_ncrit = out.fn_for_friction.abs();

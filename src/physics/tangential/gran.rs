@@ -26,7 +26,7 @@ fn rj_lever(c: &Contact) -> f64 {
 
 impl TangentialLaw for LammpsGranHistory {
     const HISTORY: usize = 3;
-    #[inline]
+    #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let vtr = rel_tangential_velocity(c, c.ri, rj_lever(c));
         let mut xi = get3(hist) + vtr * c.dt;
@@ -63,7 +63,7 @@ pub struct LammpsGranNoHistory;
 
 impl TangentialLaw for LammpsGranNoHistory {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let vtr = rel_tangential_velocity(c, c.ri, rj_lever(c));
         let ft = capped_viscous(&vtr, out.gamma_t, p.mu * out.fn_for_friction.abs());

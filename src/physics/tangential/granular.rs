@@ -75,7 +75,7 @@ pub struct LammpsGranularHistory {
 
 impl TangentialLaw for LammpsGranularHistory {
     const HISTORY: usize = 4;
-    #[inline]
+    #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let m = self.model;
         let vtr = rel_tangential_velocity(c, c.ri, c.rj);
@@ -141,7 +141,7 @@ pub struct LammpsLinearNoHistory;
 
 impl TangentialLaw for LammpsLinearNoHistory {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let vtr = rel_tangential_velocity(c, c.ri, c.rj);
         let damp_t = p.gamma_t * out.gamma_n;

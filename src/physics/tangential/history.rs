@@ -17,7 +17,7 @@ pub struct LiggghtsHistory;
 
 impl TangentialLaw for LiggghtsHistory {
     const HISTORY: usize = 3;
-    #[inline]
+    #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (cri, crj) = liggghts_levers(c);
         let vtr = rel_tangential_velocity(c, cri, crj);

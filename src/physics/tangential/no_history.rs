@@ -25,7 +25,7 @@ pub(crate) fn capped_viscous(vtr: &V3, gamma_t: f64, f_cap: f64) -> V3 {
 
 impl TangentialLaw for LiggghtsNoHistory {
     const HISTORY: usize = 0;
-    #[inline]
+    #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
         let (cri, crj) = liggghts_levers(c);
         let vtr = rel_tangential_velocity(c, cri, crj);

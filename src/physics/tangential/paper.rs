@@ -25,7 +25,7 @@ pub struct PaperCundallStrack;
 
 impl TangentialLaw for PaperCundallStrack {
     const HISTORY: usize = 3;
-    #[inline]
+    #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (cri, crj) = liggghts_levers(c);
         let v_t = rel_tangential_velocity(c, cri, crj);
