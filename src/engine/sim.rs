@@ -93,13 +93,11 @@ pub struct Sim {
     /// saved pair list and forces instead of recomputing them, so it continues
     /// bitwise as the uninterrupted run would have.
     pub resume: bool,
-    /// Sort particles in space every this many steps, at the next rebuild
-    /// (LAMMPS `atom_modify sort`, default 1000; 0: never).
+    /// Sort particles in space at the first build unless 0 (LAMMPS
+    /// `atom_modify sort N`, default 1000; demx sorts once).
     pub sort_every: i64,
     /// Bin size of the sort (0: half the neighbour cutoff, as LAMMPS).
     pub sort_bin: f64,
-    /// Sort at this step's rebuild.
-    pub sort_due: bool,
     /// Stability guards (`demx_guard`): checks every few steps, last good state.
     pub guard: super::guard::Guard,
 }
@@ -138,7 +136,6 @@ impl Default for Sim {
             resume: false,
             sort_every: 1000,
             sort_bin: 0.0,
-            sort_due: false,
             guard: super::guard::Guard::default(),
         }
     }
@@ -202,13 +199,13 @@ impl Sim {
         let p = &mut self.particles;
         let dom = self.domain.as_mut().ok_or_else(|| Error::runtime("no box"))?;
         dom.shrink_wrap(&p.x);
-        // spatial sort (LAMMPS `Atom::sort`): at the first build and at every
-        // step that is a multiple of `sort_every` (which forces a rebuild).
-        // Fixed steps, not rebuild times: a run resumed from a restart file
-        // sorts at the same steps as the uninterrupted run, so it stays bitwise
-        // the same (a sort reorders the sums)
+        // spatial sort (LAMMPS `Atom::sort`), at the first build only: a
+        // later sort would need a rebuild at fixed steps (a restarted run does
+        // not rebuild when the uninterrupted one does, and a sort reorders the
+        // sums), and that rebuild would wrap positions at steps where LAMMPS
+        // does not, which its dumps show
         let every = self.sort_every;
-        let due = std::mem::take(&mut self.sort_due) || self.pairs.builds == 0;
+        let due = self.pairs.builds == 0;
         if every > 0 && due {
             let bin = if self.sort_bin > 0.0 { self.sort_bin } else { 0.5 * (2.0 * p.radius.iter().cloned().fold(0.0, f64::max) + self.neigh.skin) };
             let order = super::neighbor::spatial_order(p, bin);
@@ -326,11 +323,8 @@ impl Sim {
         let wanted = self.fixes.iter().any(|f| f.next_reneighbor() == Some(step));
         let tm = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        self.sort_due = self.sort_every > 0 && self.step % self.sort_every == 0;
         if self.force_rebuild || wanted || self.pairs.needs_rebuild(&self.particles, &self.neigh, self.step) {
             self.each_fix(|f, s| f.pre_exchange(s, vars))?;
-            self.rebuild()?;
-        } else if self.sort_due {
             self.rebuild()?;
         }
         let tn = t.elapsed().as_secs_f64();
