@@ -204,9 +204,7 @@ impl Sim {
         // not rebuild when the uninterrupted one does, and a sort reorders the
         // sums), and that rebuild would wrap positions at steps where LAMMPS
         // does not, which its dumps show
-        let every = self.sort_every;
-        let due = self.pairs.builds == 0;
-        if every > 0 && due {
+        if self.sort_every > 0 && self.pairs.builds == 0 {
             let bin = if self.sort_bin > 0.0 { self.sort_bin } else { 0.5 * (2.0 * p.radius.iter().cloned().fold(0.0, f64::max) + self.neigh.skin) };
             let order = super::neighbor::spatial_order(p, bin);
             if order.iter().enumerate().any(|(k, &o)| k != o) {
