@@ -63,13 +63,19 @@ def rate(text):
     return psteps / secs, psteps, secs
 
 
-def prepare(quick):
+def prepare_bed():
+    """The settled 7,500-sphere bed (target/bench/bed.data), made once."""
     os.makedirs(WORK, exist_ok=True)
     bed = os.path.join(WORK, "bed.data")
     if not os.path.exists(bed):
         print("preparing the bed (7,500 spheres settling, a few minutes)", flush=True)
         run([DEMX, "run", os.path.join(ROOT, "bench", "in.bed_prepare.liggghts"), "-var", "out", "bed.data.tmp", "--log", "none"], WORK)
         os.replace(os.path.join(WORK, "bed.data.tmp"), bed)
+    return bed
+
+
+def prepare(quick):
+    bed = prepare_bed()
     tiles = [1, 2] if quick else [1, 2, 4, 8, 12]
     for k in tiles:
         out = os.path.join(WORK, f"bed{k}x{k}.data")
