@@ -2,80 +2,141 @@
 //! operations as LAMMPS `FixNVESphere`, so demx and the engines stay in step.
 
 use super::particles::Particles;
+use crate::physics::V3;
+use rayon::prelude::*;
 
 /// LAMMPS `INERTIA` for solid spheres.
 pub const INERTIA: f64 = 0.4;
+
+/// Particles per parallel chunk. Each particle's update reads and writes only
+/// its own entries, so the result is the same bits on any thread count; below
+/// two chunks the loop runs inline (rayon's fork costs more than it saves).
+const CHUNK: usize = 4096;
+
+/// What one half-step changes of particle `i`: position, velocity, angular
+/// velocity, given its force, torque, mass and radius.
+struct Half<'a> {
+    f: &'a [V3],
+    torque: &'a [V3],
+    mass: &'a [f64],
+    radius: &'a [f64],
+    mask: &'a [u32],
+}
+
+/// Apply `step(i, x, v, omega)` to every particle of `group`, in chunks of
+/// CHUNK particles, in parallel when there are several.
+fn each_in_group<F>(p: &mut Particles, group: u32, step: F)
+where
+    F: Fn(&Half<'_>, usize, &mut V3, &mut V3, &mut V3) + Sync,
+{
+    let Particles {
+        x,
+        v,
+        omega,
+        f,
+        torque,
+        mass,
+        radius,
+        mask,
+        ..
+    } = p;
+    let h = Half {
+        f,
+        torque,
+        mass,
+        radius,
+        mask,
+    };
+    let chunk = |(c, ((xc, vc), wc)): (usize, ((&mut [V3], &mut [V3]), &mut [V3]))| {
+        let lo = c * CHUNK;
+        for q in 0..xc.len() {
+            let i = lo + q;
+            if h.mask[i] & group != 0 {
+                step(&h, i, &mut xc[q], &mut vc[q], &mut wc[q]);
+            }
+        }
+    };
+    if x.len() >= 2 * CHUNK {
+        x.par_chunks_mut(CHUNK)
+            .zip(v.par_chunks_mut(CHUNK))
+            .zip(omega.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(chunk);
+    } else {
+        x.chunks_mut(CHUNK)
+            .zip(v.chunks_mut(CHUNK))
+            .zip(omega.chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(chunk);
+    }
+}
 
 /// First half: v += dt/2 f/m; x += dt v; omega += dt/2 torque/I.
 /// `group` is the fix's group bit; `dtf = 0.5 dt` (ftm2v = 1 in si/lj/cgs).
 pub fn initial_integrate(p: &mut Particles, group: u32, dt: f64) {
     let dtf = 0.5 * dt;
     let dtfrot = dtf / INERTIA;
-    for i in 0..p.len() {
-        if p.mask[i] & group == 0 {
-            continue;
-        }
-        let dtfm = dtf / p.mass[i];
-        p.v[i] += p.f[i] * dtfm;
-        p.x[i] += p.v[i] * dt;
-        let dtirotate = dtfrot / (p.radius[i] * p.radius[i] * p.mass[i]);
-        p.omega[i] += p.torque[i] * dtirotate;
-    }
+    each_in_group(p, group, |h, i, x, v, w| {
+        let dtfm = dtf / h.mass[i];
+        *v += h.f[i] * dtfm;
+        *x += *v * dt;
+        let dtirotate = dtfrot / (h.radius[i] * h.radius[i] * h.mass[i]);
+        *w += h.torque[i] * dtirotate;
+    });
 }
 
 /// Second half: v += dt/2 f/m; omega += dt/2 torque/I.
 pub fn final_integrate(p: &mut Particles, group: u32, dt: f64) {
     let dtf = 0.5 * dt;
     let dtfrot = dtf / INERTIA;
-    for i in 0..p.len() {
-        if p.mask[i] & group == 0 {
-            continue;
-        }
-        let dtfm = dtf / p.mass[i];
-        p.v[i] += p.f[i] * dtfm;
-        let dtirotate = dtfrot / (p.radius[i] * p.radius[i] * p.mass[i]);
-        p.omega[i] += p.torque[i] * dtirotate;
-    }
+    each_in_group(p, group, |h, i, _x, v, w| {
+        let dtfm = dtf / h.mass[i];
+        *v += h.f[i] * dtfm;
+        let dtirotate = dtfrot / (h.radius[i] * h.radius[i] * h.mass[i]);
+        *w += h.torque[i] * dtirotate;
+    });
 }
 
 /// `fix nve` first half: translation only (LAMMPS `FixNVE`); angular
 /// velocity is left alone, so particles integrated this way do not rotate.
 pub fn initial_integrate_nve(p: &mut Particles, group: u32, dt: f64) {
     let dtf = 0.5 * dt;
-    for i in 0..p.len() {
-        if p.mask[i] & group == 0 {
-            continue;
-        }
-        let dtfm = dtf / p.mass[i];
-        p.v[i] += p.f[i] * dtfm;
-        p.x[i] += p.v[i] * dt;
-    }
+    each_in_group(p, group, |h, i, x, v, _w| {
+        let dtfm = dtf / h.mass[i];
+        *v += h.f[i] * dtfm;
+        *x += *v * dt;
+    });
 }
 
 /// `fix nve` second half.
 pub fn final_integrate_nve(p: &mut Particles, group: u32, dt: f64) {
     let dtf = 0.5 * dt;
-    for i in 0..p.len() {
-        if p.mask[i] & group == 0 {
-            continue;
-        }
-        let dtfm = dtf / p.mass[i];
-        p.v[i] += p.f[i] * dtfm;
-    }
+    each_in_group(p, group, |h, i, _x, v, _w| {
+        let dtfm = dtf / h.mass[i];
+        *v += h.f[i] * dtfm;
+    });
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::engine::particles::NewParticle;
-    use crate::physics::V3;
 
     #[test]
     fn free_fall_is_exact_for_constant_force() {
         // velocity Verlet integrates constant acceleration exactly:
         // z(t) = z0 + v0 t - g t^2 / 2
         let mut p = Particles::default();
-        p.push(NewParticle { tag: 1, kind: 1, mask: 1, x: V3::new(0.0, 0.0, 10.0), v: V3::new(0.0, 0.0, 2.0), omega: V3::zeros(), radius: 0.01, density: 2500.0 });
+        p.push(NewParticle {
+            tag: 1,
+            kind: 1,
+            mask: 1,
+            x: V3::new(0.0, 0.0, 10.0),
+            v: V3::new(0.0, 0.0, 2.0),
+            omega: V3::zeros(),
+            radius: 0.01,
+            density: 2500.0,
+        });
         let g = 9.81;
         let dt = 1e-3;
         let n = 1000;
@@ -87,7 +148,67 @@ mod tests {
         }
         let t = n as f64 * dt;
         let z = 10.0 + 2.0 * t - 0.5 * g * t * t;
-        assert!((p.x[0].z - z).abs() < 1e-9 * z.abs(), "{} vs {}", p.x[0].z, z);
+        assert!(
+            (p.x[0].z - z).abs() < 1e-9 * z.abs(),
+            "{} vs {}",
+            p.x[0].z,
+            z
+        );
         assert!((p.v[0].z - (2.0 - g * t)).abs() < 1e-9);
+    }
+
+    /// Several chunks (the parallel path): every particle gets the update of
+    /// the formula, bit for bit, on one thread and on three, and particles
+    /// outside the group are left alone.
+    #[test]
+    fn chunked_update_is_the_formula_on_any_thread_count() {
+        let n = 3 * CHUNK + 17;
+        let make = || {
+            let mut p = Particles::default();
+            for k in 0..n {
+                let s = (k as f64 * 0.618).fract();
+                p.push(NewParticle {
+                    tag: k as i64 + 1,
+                    kind: 1,
+                    mask: if k % 5 == 0 { 2 } else { 1 },
+                    x: V3::new(s, 1.0 - s, 2.0 * s),
+                    v: V3::new(0.1 * s, -0.2, 0.3 * s),
+                    omega: V3::new(1.0, s, -s),
+                    radius: 1e-3 * (1.0 + s),
+                    density: 2500.0,
+                });
+                p.f[k] = V3::new(s - 0.5, 0.25 * s, -1.0);
+                p.torque[k] = V3::new(1e-6 * s, -1e-6, 2e-6 * s);
+            }
+            p
+        };
+        let dt = 1e-5;
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut p = make();
+            pool.install(|| {
+                initial_integrate(&mut p, 1, dt);
+                final_integrate(&mut p, 1, dt);
+            });
+            p
+        };
+        let (a, b, p0) = (run(1), run(3), make());
+        for i in 0..n {
+            assert_eq!(a.x[i], b.x[i]);
+            assert_eq!(a.v[i], b.v[i]);
+            assert_eq!(a.omega[i], b.omega[i]);
+            if p0.mask[i] & 1 == 0 {
+                assert_eq!(a.x[i], p0.x[i], "outside the group: unchanged");
+                assert_eq!(a.v[i], p0.v[i]);
+                continue;
+            }
+            let dtfm = 0.5 * dt / p0.mass[i];
+            let v = p0.v[i] + p0.f[i] * dtfm;
+            assert_eq!(a.x[i], p0.x[i] + v * dt);
+            assert_eq!(a.v[i], v + p0.f[i] * dtfm);
+        }
     }
 }
