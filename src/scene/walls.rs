@@ -15,6 +15,10 @@ use crate::physics::normal::granular::{GranularDamping, GranularNormal};
 use crate::physics::normal::jkr::jkr_pulloff_overlap;
 use crate::physics::{Contact, V3};
 use crate::script::{Command, Variables, Word};
+use rayon::prelude::*;
+
+/// Particles per parallel chunk of the wall pass (as the integrator's).
+const CHUNK: usize = 4096;
 
 /// A granular wall of primitive shape.
 pub struct WallGran {
@@ -59,59 +63,98 @@ impl Fix for WallGran {
         let shift = self.motion.shift(axis, t);
         let vwall = self.motion.velocity(t);
         let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
-        let p = &mut sim.particles;
-        let w = self.width.max(1);
-        for i in 0..p.len() {
-            if p.mask[i] & self.group == 0 {
-                continue;
-            }
-            let hist = &mut p.extra[col].data[i * w..i * w + self.width];
-            let ri = p.radius[i];
-            let pp = self.table.get(p.kind[i], self.wall_type);
-            // a JKR contact lives on to the pull-off overlap (< 0): look that
-            // far; LAMMPS's zcylinder finds no contact once the sphere is
-            // off the wall (its `delr > radius` test)
-            let reach = if self.jkr && self.cyl_radius.is_none() { -jkr_pulloff_overlap(ri, pp.y_eff, pp.cohesion) } else { 0.0 };
-            let Some((delta, n, _pt)) = self.wall.contact(p.x[i], ri + reach, shift) else {
-                hist.fill(0.0);
-                continue;
-            };
-            let delta = delta - reach;
-            if delta <= 0.0 && !self.jkr {
-                hist.fill(0.0);
-                continue;
-            }
-            // LAMMPS zcylinder: the wall's curvature enters R* through
-            // rwall = -2 R_c (met from inside) or +2 R_c (outside)
-            let r_eff = match self.cyl_radius {
-                Some(rc) => {
-                    let rho = (p.x[i].x * p.x[i].x + p.x[i].y * p.x[i].y).sqrt();
-                    let rwall = if rho < rc { -2.0 * rc } else { 2.0 * rc };
-                    ri * rwall / (ri + rwall)
+        let this = &*self;
+        let (group, width, w) = (this.group, this.width, this.width.max(1));
+        let crate::engine::particles::Particles {
+            x,
+            v,
+            omega,
+            f,
+            torque,
+            radius,
+            mass,
+            kind,
+            mask,
+            extra,
+            ..
+        } = &mut sim.particles;
+        let (x, v, omega, radius, mass, kind, mask) =
+            (&*x, &*v, &*omega, &*radius, &*mass, &*kind, &*mask);
+        let data = &mut extra[col].data;
+        // particles in fixed chunks, in parallel from two chunks up: each
+        // particle touches only its own force, torque and history, so the
+        // bits do not depend on the thread count
+        let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| {
+            for q in 0..fc.len() {
+                let i = c * CHUNK + q;
+                if mask[i] & group == 0 {
+                    continue;
                 }
-                None => ri,
-            };
-            let mi = p.mass[i];
-            let vr = p.v[i] - vwall;
-            let c = Contact {
-                n,
-                r: ri - delta,
-                delta,
-                ri,
-                rj: f64::INFINITY,
-                r_eff,
-                mi,
-                mj: f64::INFINITY,
-                m_eff: mi,
-                vr,
-                vn: vr.dot(&n),
-                wi: p.omega[i],
-                wj: V3::zeros(),
-                dt,
-            };
-            let out = self.kernel.contact(&c, pp, hist);
-            p.f[i] += out.force_i(&c);
-            p.torque[i] += out.torque_i;
+                let hist = &mut hc[q * w..q * w + width];
+                let ri = radius[i];
+                let pp = this.table.get(kind[i], this.wall_type);
+                // a JKR contact lives on to the pull-off overlap (< 0): look that
+                // far; LAMMPS's zcylinder finds no contact once the sphere is
+                // off the wall (its `delr > radius` test)
+                let reach = if this.jkr && this.cyl_radius.is_none() {
+                    -jkr_pulloff_overlap(ri, pp.y_eff, pp.cohesion)
+                } else {
+                    0.0
+                };
+                let Some((delta, n, _pt)) = this.wall.contact(x[i], ri + reach, shift) else {
+                    hist.fill(0.0);
+                    continue;
+                };
+                let delta = delta - reach;
+                if delta <= 0.0 && !this.jkr {
+                    hist.fill(0.0);
+                    continue;
+                }
+                // LAMMPS zcylinder: the wall's curvature enters R* through
+                // rwall = -2 R_c (met from inside) or +2 R_c (outside)
+                let r_eff = match this.cyl_radius {
+                    Some(rc) => {
+                        let rho = (x[i].x * x[i].x + x[i].y * x[i].y).sqrt();
+                        let rwall = if rho < rc { -2.0 * rc } else { 2.0 * rc };
+                        ri * rwall / (ri + rwall)
+                    }
+                    None => ri,
+                };
+                let mi = mass[i];
+                let vr = v[i] - vwall;
+                let c = Contact {
+                    n,
+                    r: ri - delta,
+                    delta,
+                    ri,
+                    rj: f64::INFINITY,
+                    r_eff,
+                    mi,
+                    mj: f64::INFINITY,
+                    m_eff: mi,
+                    vr,
+                    vn: vr.dot(&n),
+                    wi: omega[i],
+                    wj: V3::zeros(),
+                    dt,
+                };
+                let out = this.kernel.contact(&c, pp, hist);
+                fc[q] += out.force_i(&c);
+                tc[q] += out.torque_i;
+            }
+        };
+        if f.len() >= 2 * CHUNK {
+            f.par_chunks_mut(CHUNK)
+                .zip(torque.par_chunks_mut(CHUNK))
+                .zip(data.par_chunks_mut(CHUNK * w))
+                .enumerate()
+                .for_each(body);
+        } else {
+            f.chunks_mut(CHUNK)
+                .zip(torque.chunks_mut(CHUNK))
+                .zip(data.chunks_mut(CHUNK * w))
+                .enumerate()
+                .for_each(body);
         }
         Ok(())
     }
