@@ -8,7 +8,7 @@ use std::process::Command;
 
 fn run(deck: &str, threads: usize) -> Vec<u8> {
     let dir = tempfile::tempdir().expect("tempdir");
-    let deck = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("templates/settle").join(deck);
+    let deck = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(deck);
     let out = Command::new(env!("CARGO_BIN_EXE_demx"))
         .current_dir(dir.path())
         .args(["run", "--quiet", "--log", "none", "--threads", &threads.to_string()])
@@ -35,10 +35,17 @@ fn same_bytes(deck: &str) {
 
 #[test]
 fn settle_liggghts_threads_1_and_2_identical() {
-    same_bytes("in.settle.liggghts");
+    same_bytes("templates/settle/in.settle.liggghts");
 }
 
 #[test]
 fn settle_lammps_threads_1_and_2_identical() {
-    same_bytes("in.settle.lammps");
+    same_bytes("templates/settle/in.settle.lammps");
+}
+
+/// 9,216 spheres: the pair pass splits into five blocks, the integrator and
+/// the wall into three chunks, so two threads really share the work.
+#[test]
+fn bed_of_9216_threads_1_and_2_identical() {
+    same_bytes("tests/decks/threads/in.bed9k.lammps");
 }
