@@ -47,7 +47,7 @@ def scaled_gamma(y):
 
 def default_cases():
     cases = []
-    for y in (1e7, 1e8, 1e9):
+    for y in (1e7, 1e8, 1e9, Y_PAPER):
         cases.append((y, GAMMA_PAPER, "paper gamma"))
     for y in (1e7, 1e8):
         cases.append((y, scaled_gamma(y), "gamma (Y/63 GPa)^(2/5)"))
@@ -84,6 +84,8 @@ def main():
     ap.add_argument("--cases", help="Y:gamma,... (gamma 'scaled' for gamma (Y/63 GPa)^(2/5))")
     ap.add_argument("--quick", action="store_true", help="N = 200, Y = 1e7 only: a smoke run")
     ap.add_argument("--out", default=os.path.join(ROOT, "validation/heap_cohesion.md"))
+    ap.add_argument("--cache", default=os.path.join(ROOT, "target/heap_cohesion.json"),
+                    help="finished runs, reused by a later invocation with the same d, N, Y, gamma and seed")
     a = ap.parse_args()
     if a.quick:
         a.n = 200
@@ -99,14 +101,23 @@ def main():
     if not os.path.exists(a.demx):
         sys.exit("build first: cargo build --release")
     started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
-    jobs = [(y, g, why, s) for (y, g, why) in cases for s in SEEDS[:a.seeds]]
+    # stiffest first: they take longest
+    jobs = sorted(((y, g, why, s) for (y, g, why) in cases for s in SEEDS[:a.seeds]), key=lambda j: -j[0])
+    cache = json.load(open(a.cache)) if os.path.exists(a.cache) else {}
+    ckey = lambda y, g, s: f"d={a.d!r} n={a.n} Y={y!r} gamma={g!r} seed={s}"
+    results = {j: cache[ckey(j[0], j[1], j[3])] for j in jobs if ckey(j[0], j[1], j[3]) in cache}
     with cf.ThreadPoolExecutor(a.jobs) as ex:
-        futs = {ex.submit(run_one, a.demx, a.d, a.n, y, g, s): (y, g, why, s) for (y, g, why, s) in jobs}
-        results = {}
+        futs = {ex.submit(run_one, a.demx, a.d, a.n, y, g, s): (y, g, why, s) for (y, g, why, s) in jobs if (y, g, why, s) not in results}
         for f in cf.as_completed(futs):
             key = futs[f]
             results[key] = f.result()
             r = results[key]
+            if "theta" in r:
+                cache[ckey(key[0], key[1], key[3])] = r
+                os.makedirs(os.path.dirname(a.cache), exist_ok=True)
+                with open(a.cache + ".tmp", "w") as fc:
+                    json.dump(cache, fc)
+                os.replace(a.cache + ".tmp", a.cache)
             print(f"Y={key[0]:g} gamma={key[1]:.3g} seed={key[3]}: "
                   + (f"theta_r={r['theta']:.2f} wall={r['wall']:.0f}s" if "theta" in r else r.get("error", "?")),
                   file=sys.stderr, flush=True)
