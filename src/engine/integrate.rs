@@ -11,7 +11,7 @@ pub const INERTIA: f64 = 0.4;
 /// Particles per parallel chunk. Each particle's update reads and writes only
 /// its own entries, so the result is the same bits on any thread count; below
 /// two chunks the loop runs inline (rayon's fork costs more than it saves).
-const CHUNK: usize = 4096;
+pub const CHUNK: usize = 4096;
 
 /// What one half-step changes of particle `i`: position, velocity, angular
 /// velocity, given its force, torque, mass and radius.

@@ -15,10 +15,8 @@ use crate::physics::normal::granular::{GranularDamping, GranularNormal};
 use crate::physics::normal::jkr::jkr_pulloff_overlap;
 use crate::physics::{Contact, V3};
 use crate::script::{Command, Variables, Word};
+use crate::engine::integrate::CHUNK;
 use rayon::prelude::*;
-
-/// Particles per parallel chunk of the wall pass (as the integrator's).
-const CHUNK: usize = 4096;
 
 /// A granular wall of primitive shape.
 pub struct WallGran {
