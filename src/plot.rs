@@ -205,16 +205,7 @@ fn save_atomically(path: &Path, buf: &[u8], (w, h): (u32, u32)) -> Result<()> {
         bm.blit_bitmap((0, 0), (w, h), buf).map_err(|e| io(&e))?;
         bm.present().map_err(|e| io(&e))?;
     }
-    // The temporary file is private (0600); give the plot the usual mode,
-    // or keep the one of the file it replaces.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::metadata(path).map(|m| m.permissions()).unwrap_or_else(|_| std::fs::Permissions::from_mode(0o644));
-        tmp.as_file().set_permissions(mode).map_err(|e| io(&e))?;
-    }
-    tmp.persist(path).map_err(|e| io(&e.error))?;
-    Ok(())
+    crate::io::persist_public(tmp, path).map_err(|e| io(&e))
 }
 
 /// Axis range of one axis over every drawable value.

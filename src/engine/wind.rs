@@ -223,11 +223,17 @@ fn vol_below(zc: f64, r: f64, t: f64) -> f64 {
 
 /// Solid fraction per bin (exact sphere-slab volumes) of all particles.
 pub fn solid_fraction(sim: &Sim, edges: &[f64], area: f64) -> Vec<f64> {
+    let p = &sim.particles;
+    solid_fraction_of((0..p.len()).map(|i| (p.x[i].z, p.radius[i])), edges, area)
+}
+
+/// Solid fraction per bin of spheres given as (centre height, radius): the
+/// volume of each sphere between two bin edges (exact sphere-slab volumes)
+/// over the bin's volume `area` x height. Also used by `demx saltation` on dumps.
+pub fn solid_fraction_of(spheres: impl Iterator<Item = (f64, f64)>, edges: &[f64], area: f64) -> Vec<f64> {
     let nb = edges.len().saturating_sub(1);
     let mut phi = vec![0.0; nb];
-    let p = &sim.particles;
-    for i in 0..p.len() {
-        let (z, r) = (p.x[i].z, p.radius[i]);
+    for (z, r) in spheres {
         let mut k = edges.partition_point(|&e| e <= z - r).saturating_sub(1);
         while k < nb && edges[k] < z + r {
             phi[k] += vol_below(z, r, edges[k + 1]) - vol_below(z, r, edges[k]);
