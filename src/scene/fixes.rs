@@ -187,7 +187,7 @@ pub enum Component {
     Null,
 }
 
-fn component(a: &mut Args, what: &str) -> Result<Component> {
+pub(crate) fn component(a: &mut Args, what: &str) -> Result<Component> {
     let w = a.word(what)?;
     if w.text == "NULL" {
         return Ok(Component::Null);
@@ -198,16 +198,23 @@ fn component(a: &mut Args, what: &str) -> Result<Component> {
     Ok(Component::Const(super::args::parse_f64(w)?))
 }
 
-fn component_values(c: &Component, vars: &Variables, sim: &Sim) -> Result<Option<Vec<f64>>> {
+/// Per-particle values of a component: a constant for all, an atom-style
+/// variable, or an equal-style variable for all; None for NULL. `what` names
+/// the command in errors.
+pub(crate) fn component_values_for(c: &Component, vars: &Variables, sim: &Sim, what: &str) -> Result<Option<Vec<f64>>> {
     let n = sim.particles.len();
     Ok(match c {
         Component::Null => None,
         Component::Const(v) => Some(vec![*v; n]),
         Component::Var(name) => match vars.eval_atom(name, sim) {
             Ok(v) => Some(v),
-            Err(_) => Some(vec![vars.eval_equal(name, sim).map_err(|e| Error::runtime(format!("fix addforce: {e}")))?; n]),
+            Err(_) => Some(vec![vars.eval_equal(name, sim).map_err(|e| Error::runtime(format!("{what}: {e}")))?; n]),
         },
     })
+}
+
+fn component_values(c: &Component, vars: &Variables, sim: &Sim) -> Result<Option<Vec<f64>>> {
+    component_values_for(c, vars, sim, "fix addforce")
 }
 
 /// `fix ID group addforce fx fy fz` and `setforce`.

@@ -194,7 +194,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
         "create_atoms" => create_atoms(s, cmd, &mut a),
         "group" => group_command(s, cmd, &mut a),
         "set" => set_command(s, cmd, &mut a),
-        "velocity" => velocity_command(s, cmd, &mut a),
+        "velocity" => velocity_command(s, cmd, &mut a, vars),
         "mass" => {
             a.word("type")?;
             a.f64("mass")?;
@@ -576,19 +576,20 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     Ok(())
 }
 
-fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args, vars: &Variables) -> Result<()> {
     s.need_box(cmd)?;
     let g = a.word("group")?;
     let bit = s.group(g)?;
     let style = a.choice("velocity style", &["set", "create", "zero", "ramp", "scale"])?;
     match style.text.as_str() {
         "set" => {
-            let mut comp = [None; 3];
-            for c in comp.iter_mut() {
-                let w = a.word("component")?;
-                if w.text != "NULL" {
-                    *c = Some(parse_f64(w)?);
-                }
+            use super::fixes::Component;
+            // each component: a number, NULL, or v_name (equal- or atom-style,
+            // as LAMMPS; the lattice scale applies to numbers only)
+            let mut comps = vec![];
+            for what in ["vx", "vy", "vz"] {
+                let span = a.peek().map_or(cmd.span, |w| w.span);
+                comps.push((super::fixes::component(a, what)?, span));
             }
             let mut sum = false;
             let mut scale = lattice_spacing(s);
@@ -606,14 +607,22 @@ fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> 
                     }
                 }
             }
+            let mut comp: [Option<Vec<f64>>; 3] = [None, None, None];
+            for d in 0..3 {
+                let (c, span) = &comps[d];
+                comp[d] = super::fixes::component_values_for(c, vars, &s.sim, "velocity")
+                    .map_err(|e| Error::deck(*span, e.message().trim_start_matches("velocity: ").to_string()))?;
+                if let (Component::Const(_), Some(v)) = (c, comp[d].as_mut()) {
+                    v.iter_mut().for_each(|x| *x *= scale[d]);
+                }
+            }
             let p = &mut s.sim.particles;
             for i in 0..p.len() {
                 if p.mask[i] & bit == 0 {
                     continue;
                 }
                 for d in 0..3 {
-                    if let Some(v) = comp[d] {
-                        let v = v * scale[d];
+                    if let Some(v) = comp[d].as_ref().map(|c| c[i]) {
                         if sum {
                             p.v[i][d] += v;
                         } else {
