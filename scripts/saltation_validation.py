@@ -20,7 +20,8 @@ with plots, then reassembles VALIDATION.md.
 start of the averaging window. Finished runs are cached in --out (a run is
 redone when its folder has no result.json). --quick: a few hundredths of a
 second per run, to try the pipeline (its numbers mean nothing). --reanalyse:
-measure the finished runs again with the current `demx saltation` (no new runs).
+measure the finished runs again with the current `demx saltation` and report
+them; runs not finished are listed as not run (none is started).
 
 Cost on the 2-core machine, one thread per run: the erodible bed of 20 x 6 d_m
 holds ~2,300 grains and runs ~2,000 steps/s, so 3 s of transport take ~25 min.
@@ -151,6 +152,8 @@ def transport(args, c):
         if not args.reanalyse:
             return r
         wall, steps = r["wall_s"], r["steps"]
+    elif args.reanalyse:
+        raise RuntimeError("not run (--reanalyse measures finished runs only)")
     else:
         bed = prepare_bed(args, c)
         os.makedirs(d, exist_ok=True)

@@ -262,6 +262,17 @@ fn compare_and_saltation_plots() {
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.starts_with("step,time,Q"), "{stdout}");
     let img = read_png(&out);
-    assert_eq!((img.w, img.h), PANEL_SIZE);
-    assert!(img.count(BLUE, 0..img.h) > 200);
+    // the flux over time, and the concentration profile above the bed (the
+    // dump has z, vz and radius, and both grains fly above the floor)
+    assert_eq!((img.w, img.h), (2 * PANEL_SIZE.0, PANEL_SIZE.1));
+    let blue_in = |x0: u32, x1: u32| (0..img.h).flat_map(|y| (x0..x1).map(move |x| (x, y))).filter(|&(x, y)| img.rgb(x, y) == BLUE).count();
+    assert!(blue_in(0, PANEL_SIZE.0) > 200, "flux curve");
+    assert!(blue_in(PANEL_SIZE.0, img.w) > 20, "profile markers");
+    // a dump without heights has the flux panel alone
+    let flat = dir.path().join("flat.dump");
+    std::fs::write(&flat, std::fs::read_to_string(&a).unwrap().replace("id type x y z vx vy vz radius mass", "id type x y zz vx vy vz radius mass")).unwrap();
+    let out = dir.path().join("q1.png");
+    let (code, _, stderr) = demx(&["saltation", "--plot", out.to_str().unwrap(), flat.to_str().unwrap()], &[]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!((read_png(&out).w, read_png(&out).h), PANEL_SIZE);
 }
