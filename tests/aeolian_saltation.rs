@@ -148,7 +148,9 @@ fn decay_length_of_an_exponential_profile() {
     let z: Vec<f64> = (0..40).map(|k| (k as f64 + 0.5) * 1e-4).collect();
     let nu: Vec<f64> = z.iter().map(|z| 0.02 * (-z / l_nu).exp()).collect();
     let n: Vec<u64> = nu.iter().map(|v| (v * 1e5) as u64).collect();
-    let (n0, l, bins) = fit_decay(&z, &nu, &n, 4e-4).unwrap();
+    let (n0, l, bins, top) = fit_decay(&z, &nu, &n, 4e-4).unwrap();
+    let used: Vec<f64> = z.iter().zip(&n).filter(|(z, n)| **z >= 4e-4 && **n >= 5).map(|(z, _)| *z).collect();
+    assert_eq!(top, *used.last().unwrap(), "highest bin in the fit");
     assert!((l - l_nu).abs() < 1e-9 * l_nu && (n0 - 0.02).abs() < 1e-9, "{l} {n0}");
     assert!(bins >= 3 && z.iter().zip(&n).filter(|(z, n)| **z >= 4e-4 && **n >= 5).count() == bins);
     // too few bins, or a profile that does not decay, give no fit

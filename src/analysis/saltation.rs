@@ -292,9 +292,10 @@ pub fn hops(up: [f64; 3], down: [f64; 3], n_up: u64, n_down: u64, g: f64) -> Hop
 /// time-averaged concentration profile: least squares on ln nu, each bin
 /// weighted by its number of samples (the variance of ln n is about 1/n),
 /// over bins centred at least `from` above the bed with 5 samples or more.
-/// Returns (nu_0, l_nu, bins used); None with fewer than 3 bins or no decay.
-pub fn fit_decay(z: &[f64], nu: &[f64], samples: &[u64], from: f64) -> Option<(f64, f64, usize)> {
-    let (mut sw, mut sx, mut sy, mut sxx, mut sxy, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0);
+/// Returns (nu_0, l_nu, bins used, highest bin centre used); None with fewer
+/// than 3 bins or no decay.
+pub fn fit_decay(z: &[f64], nu: &[f64], samples: &[u64], from: f64) -> Option<(f64, f64, usize, f64)> {
+    let (mut sw, mut sx, mut sy, mut sxx, mut sxy, mut n, mut top) = (0.0, 0.0, 0.0, 0.0, 0.0, 0, f64::NAN);
     for k in 0..z.len() {
         if z[k] < from || samples[k] < 5 || !(nu[k] > 0.0) {
             continue;
@@ -306,6 +307,7 @@ pub fn fit_decay(z: &[f64], nu: &[f64], samples: &[u64], from: f64) -> Option<(f
         sxx += w * x * x;
         sxy += w * x * y;
         n += 1;
+        top = x;
     }
     let det = sw * sxx - sx * sx;
     if n < 3 || !(det > 0.0) {
@@ -313,7 +315,7 @@ pub fn fit_decay(z: &[f64], nu: &[f64], samples: &[u64], from: f64) -> Option<(f
     }
     let slope = (sw * sxy - sx * sy) / det;
     let icpt = (sy - slope * sx) / sw;
-    (slope < 0.0).then(|| (icpt.exp(), -1.0 / slope, n))
+    (slope < 0.0).then(|| (icpt.exp(), -1.0 / slope, n, top))
 }
 
 /// Time-averaged results over the frames at or after `from`.
@@ -349,6 +351,8 @@ pub struct Summary {
     pub l_nu_dm: Option<f64>,
     /// Bins in the fit.
     pub fit_bins: usize,
+    /// Height above the bed of the highest bin in the fit, in d_m.
+    pub fit_top_dm: Option<f64>,
     /// Hop statistics (Eqs. 12-15).
     pub hops: Hops,
 }
@@ -426,6 +430,7 @@ pub fn analyse(paths: &[String], s: &Settings) -> Result<Analysis> {
         l_nu: fit.map(|f| f.1),
         l_nu_dm: fit.map(|f| f.1 / s.d_m),
         fit_bins: fit.map_or(0, |f| f.2),
+        fit_top_dm: fit.map(|f| f.3 / s.d_m),
         hops: hops(up, down, n_up, n_down, s.g),
     };
     Ok(Analysis { frames, profile, summary })
@@ -576,13 +581,13 @@ fn profile_chart(a: &Analysis, s: &Settings) -> crate::plot::Chart {
     use crate::plot::{Chart, Series, SeriesKind};
     let pts: Vec<(f64, f64)> = a.profile.iter().filter(|p| p.1 > 0.0 && p.2 > 0).map(|p| (p.0 / s.d_m, p.1)).collect();
     let mut series = vec![Series { label: "solid fraction above the bed".into(), points: pts.clone(), kind: SeriesKind::Points }];
-    if let (Some(n0), Some(l)) = (a.summary.nu0, a.summary.l_nu) {
-        let zmax = pts.last().map_or(10.0, |p| p.0);
+    if let (Some(n0), Some(l), Some(zmax)) = (a.summary.nu0, a.summary.l_nu, a.summary.fit_top_dm) {
+        // over the bins the fit used
         let fit = (0..=50).map(|k| {
             let z = s.fit_from + (zmax - s.fit_from) * k as f64 / 50.0;
             (z, n0 * (-z * s.d_m / l).exp())
         });
-        series.push(Series { label: format!("Eq. 17 fit, l_nu = {:.2} d_m", l / s.d_m), points: fit.collect(), kind: SeriesKind::Line });
+        series.push(Series { label: format!("Eq. 17 fit, l_nu = {:.2} d_m ({:.0}-{:.0} d_m)", l / s.d_m, s.fit_from, zmax), points: fit.collect(), kind: SeriesKind::Line });
     }
     Chart {
         title: "concentration above the bed".into(),
