@@ -101,8 +101,7 @@ pub fn shields(ustar: f64, s: &Settings) -> f64 {
 pub fn frame_flux(f: &Frame, s: &Settings) -> Result<f64> {
     let cv = f.col(&s.vcol).ok_or_else(|| Error::usage(format!("dump frame at step {} has no column {}", f.timestep, s.vcol)))?;
     let cm = f.col("mass");
-    let cr = f.col("radius").or_else(|| f.col("diameter"));
-    let half = f.col("radius").is_none();
+    let cr = radius_column(f);
     if cm.is_none() && cr.is_none() {
         return Err(Error::usage(format!("dump frame at step {} has neither mass nor radius", f.timestep)));
     }
@@ -122,16 +121,19 @@ pub fn frame_flux(f: &Frame, s: &Settings) -> Result<f64> {
         let m = match cm {
             Some(c) => f.get(r, c).unwrap_or(0.0),
             None => {
-                let mut rad = cr.and_then(|c| f.get(r, c)).unwrap_or(0.0);
-                if half {
-                    rad *= 0.5;
-                }
+                let rad = cr.and_then(|(c, scale)| f.get(r, c).map(|v| v * scale)).unwrap_or(0.0);
                 s.rho_p * 4.0 / 3.0 * PI * rad.powi(3)
             }
         };
         sum += m * f.get(r, cv).unwrap_or(0.0);
     }
     Ok(sum / area)
+}
+
+/// The column of the grain size and the factor that makes it a radius:
+/// `radius` (1), else `diameter` (1/2).
+fn radius_column(f: &Frame) -> Option<(usize, f64)> {
+    f.col("radius").map(|c| (c, 1.0)).or_else(|| f.col("diameter").map(|c| (c, 0.5)))
 }
 
 /// One row of the time series: (step, time, Q).
@@ -176,10 +178,7 @@ pub struct Layer {
 /// None when the frame lacks `z`, `vz` or the radius.
 pub fn frame_layer(f: &Frame, s: &Settings) -> Option<Layer> {
     let (cz, cvz, cvx) = (f.col("z")?, f.col("vz")?, f.col(&s.vcol)?);
-    let (cr, half) = match f.col("radius") {
-        Some(c) => (c, 1.0),
-        None => (f.col("diameter")?, 0.5),
-    };
+    let (cr, half) = radius_column(f)?;
     let ct = f.col("type");
     let of_type = |r: usize, t: Option<f64>| match (t, ct) {
         (Some(t), Some(c)) => f.get(r, c) == Some(t),
@@ -195,7 +194,7 @@ pub fn frame_layer(f: &Frame, s: &Settings) -> Option<Layer> {
     let area = (b[0][1] - b[0][0]) * (b[1][1] - b[1][0]);
     let rows = 0..f.natoms;
     let ground = s.ground.unwrap_or_else(|| {
-        let top = rows.clone().filter(|&r| rigid(r)).map(|r| sphere(r).0 + sphere(r).1).fold(f64::NEG_INFINITY, f64::max);
+        let top = rows.clone().filter(|&r| rigid(r)).map(sphere).map(|(z, rad)| z + rad).fold(f64::NEG_INFINITY, f64::max);
         if top.is_finite() {
             top
         } else {
@@ -203,7 +202,7 @@ pub fn frame_layer(f: &Frame, s: &Settings) -> Option<Layer> {
         }
     });
     let dz = bin_height(s);
-    let top = rows.clone().map(|r| sphere(r).0 + sphere(r).1).fold(ground, f64::max);
+    let top = rows.clone().map(sphere).map(|(z, rad)| z + rad).fold(ground, f64::max);
     // one empty bin above the highest grain, so that the bed surface is
     // interpolated towards it (bed_from_phi) rather than set to the grid top
     let nb = ((top - b[2][0]) / dz).ceil() as usize + 1;

@@ -199,22 +199,18 @@ pub(crate) fn component(a: &mut Args, what: &str) -> Result<Component> {
 }
 
 /// Per-particle values of a component: a constant for all, an atom-style
-/// variable, or an equal-style variable for all; None for NULL. `what` names
-/// the command in errors.
-pub(crate) fn component_values_for(c: &Component, vars: &Variables, sim: &Sim, what: &str) -> Result<Option<Vec<f64>>> {
+/// variable, or an equal-style variable for all; None for NULL. An error is
+/// the evaluator's message; the caller says which command it concerns.
+pub(crate) fn component_values(c: &Component, vars: &Variables, sim: &Sim) -> std::result::Result<Option<Vec<f64>>, String> {
     let n = sim.particles.len();
     Ok(match c {
         Component::Null => None,
         Component::Const(v) => Some(vec![*v; n]),
         Component::Var(name) => match vars.eval_atom(name, sim) {
             Ok(v) => Some(v),
-            Err(_) => Some(vec![vars.eval_equal(name, sim).map_err(|e| Error::runtime(format!("{what}: {e}")))?; n]),
+            Err(_) => Some(vec![vars.eval_equal(name, sim)?; n]),
         },
     })
-}
-
-fn component_values(c: &Component, vars: &Variables, sim: &Sim) -> Result<Option<Vec<f64>>> {
-    component_values_for(c, vars, sim, "fix addforce")
 }
 
 /// `fix ID group addforce fx fy fz` and `setforce`.
@@ -243,11 +239,8 @@ impl Fix for AddForce {
         }
     }
     fn post_force(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
-        let vals = [
-            component_values(&self.comp[0], vars, sim)?,
-            component_values(&self.comp[1], vars, sim)?,
-            component_values(&self.comp[2], vars, sim)?,
-        ];
+        let value = |c: &Component| component_values(c, vars, sim).map_err(|e| Error::runtime(format!("fix addforce: {e}")));
+        let vals = [value(&self.comp[0])?, value(&self.comp[1])?, value(&self.comp[2])?];
         let p = &mut sim.particles;
         self.total = V3::zeros();
         for i in 0..p.len() {

@@ -610,8 +610,7 @@ fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args, vars: &Variabl
             let mut comp: [Option<Vec<f64>>; 3] = [None, None, None];
             for d in 0..3 {
                 let (c, span) = &comps[d];
-                comp[d] = super::fixes::component_values_for(c, vars, &s.sim, "velocity")
-                    .map_err(|e| Error::deck(*span, e.message().trim_start_matches("velocity: ").to_string()))?;
+                comp[d] = super::fixes::component_values(c, vars, &s.sim).map_err(|e| Error::deck(*span, e))?;
                 if let (Component::Const(_), Some(v)) = (c, comp[d].as_mut()) {
                     v.iter_mut().for_each(|x| *x *= scale[d]);
                 }
