@@ -225,7 +225,7 @@ fn note_setup_overlaps(sim: &mut Sim) {
 fn pair_overlap(sim: &Sim, k: usize) -> f64 {
     let p = &sim.particles;
     let (a, b) = (sim.pairs.a[k] as usize, sim.pairs.b[k] as usize);
-    let r = (p.x[a] - p.x[b] - sim.pairs.shift[k]).norm();
+    let r = (p.x[a] - p.x[b] - sim.pairs.shift(k)).norm();
     (p.radius[a] + p.radius[b] - r) / p.radius[a].min(p.radius[b])
 }
 
@@ -295,7 +295,8 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
         let mut worst: Option<(usize, usize, f64)> = None;
         let n = p.len();
         let pl = &sim.pairs;
-        for (k, ((&a, &b), shift)) in pl.a.iter().zip(&pl.b).zip(&pl.shift).enumerate() {
+        for (k, (&a, &b)) in pl.a.iter().zip(&pl.b).enumerate() {
+            let shift = pl.shift(k);
             let (a, b) = (a as usize, b as usize);
             if a >= n || b >= n {
                 continue;
@@ -390,7 +391,7 @@ fn contacts_of(sim: &Sim, i: usize) -> Vec<(String, f64)> {
                 continue;
             }
             let j = if a == i { b } else { a };
-            let r = (p.x[a] - p.x[b] - pl.shift[k]).norm();
+            let r = (p.x[a] - p.x[b] - pl.shift(k)).norm();
             let delta = p.radius[a] + p.radius[b] - r;
             if delta > 0.0 || !delta.is_finite() {
                 out.push((format!("particle {}", p.tag[j]), delta / p.radius[i].min(p.radius[j])));

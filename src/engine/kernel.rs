@@ -19,7 +19,8 @@ use super::neighbor::PairList;
 #[cfg(doc)]
 use super::neighbor::BLOCK;
 use super::particles::Particles;
-use crate::physics::{CohesionLaw, Contact, ContactOut, NormalLaw, PairParams, RollingLaw, TangentialLaw, V3};
+use crate::physics::lanes::{BatchCoeffs, Coeffs, Real, Vec3, F8, LANES};
+use crate::physics::{CohesionLaw, Contact, ContactL, ContactOut, NormalLaw, OutL, PairParams, RollingLaw, TangentialLaw, V3};
 use rayon::prelude::*;
 
 /// Per-type-pair coefficients, 1-based types, row-major (ntypes+1)^2.
@@ -82,6 +83,23 @@ pub trait ContactKernel: Send + Sync {
 
 impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C, R> {
     const WIDTH: usize = N::HISTORY + C::HISTORY + T::HISTORY + R::HISTORY;
+    /// Whether the pair pass runs the laws on batches of [`LANES`] contacts:
+    /// every law has a lane form and acts only on touching pairs.
+    const BATCHED: bool = N::LANES && T::LANES && C::LANES && R::LANES && N::CONTACT_ONLY && !C::NONCONTACT && Self::WIDTH <= 16;
+
+    /// The laws on a batch of touching contacts, in the fixed order.
+    #[inline(always)]
+    fn apply_lanes<L: Real, P: Coeffs<L>>(&self, c: &ContactL<L>, pp: &P, hist: &mut [L]) -> OutL<L> {
+        let mut out = OutL::zeros();
+        let (hn, rest) = hist.split_at_mut(N::HISTORY);
+        let (hc, rest) = rest.split_at_mut(C::HISTORY);
+        let (ht, hr) = rest.split_at_mut(T::HISTORY);
+        self.normal.normal_lanes(c, pp, hn, &mut out);
+        self.cohesion.cohesion_lanes(c, pp, hc, &mut out);
+        self.tangential.tangential_lanes(c, pp, ht, &mut out);
+        self.rolling.rolling_lanes(c, pp, hr, &mut out);
+        out
+    }
 
     /// Apply the laws in their fixed order.
     #[inline(always)]
@@ -110,39 +128,107 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     }
 }
 
+/// The state of the two particles of a pair that its contact is built from.
+#[derive(Clone, Copy)]
+pub struct PairState<L> {
+    /// Position of i.
+    pub xi: Vec3<L>,
+    /// Position at which j is seen (periodic image).
+    pub xj: Vec3<L>,
+    /// Velocities.
+    pub vi: Vec3<L>,
+    /// Velocity of j.
+    pub vj: Vec3<L>,
+    /// Angular velocities.
+    pub wi: Vec3<L>,
+    /// Angular velocity of j.
+    pub wj: Vec3<L>,
+    /// Radii.
+    pub ri: L,
+    /// Radius of j.
+    pub rj: L,
+    /// Masses (infinite for frozen particles).
+    pub mi: L,
+    /// Mass of j.
+    pub mj: L,
+}
+
+/// The contact of a pair, on lanes: the one formula the scalar and the
+/// batched pass share. `r` must not be zero.
+#[inline(always)]
+pub fn contact_lanes<L: Real>(s: &PairState<L>, dt: f64) -> ContactL<L> {
+    let d = s.xi - s.xj;
+    let r = d.norm_squared().sqrt();
+    let radsum = s.ri + s.rj;
+    // unit normal by one reciprocal (as LAMMPS and LIGGGHTS: rinv = 1/r)
+    let rinv = L::splat(1.0) / r;
+    let n = d * rinv;
+    let vr = s.vi - s.vj;
+    ContactL {
+        n,
+        r,
+        delta: radsum - r,
+        ri: s.ri,
+        rj: s.rj,
+        r_eff: s.ri * s.rj / radsum,
+        mi: s.mi,
+        mj: s.mj,
+        m_eff: effective_mass(s.mi, s.mj),
+        vr,
+        vn: vr.dot(&n),
+        wi: s.wi,
+        wj: s.wj,
+        dt,
+        wall: false,
+    }
+}
+
+/// The state of pair (i, j) of one contact, j seen at `xj`.
+#[inline(always)]
+fn pair_state(p: &Particles, i: usize, j: usize, xj: V3) -> PairState<f64> {
+    let mass = |k: usize| {
+        if p.frozen[k] {
+            f64::INFINITY
+        } else {
+            p.mass[k]
+        }
+    };
+    PairState {
+        xi: p.x[i].into(),
+        xj: xj.into(),
+        vi: p.v[i].into(),
+        vj: p.v[j].into(),
+        wi: p.omega[i].into(),
+        wj: p.omega[j].into(),
+        ri: p.radius[i],
+        rj: p.radius[j],
+        mi: mass(i),
+        mj: mass(j),
+    }
+}
+
 /// Build the contact of pair (i, j) where j is seen at `xj`.
 #[inline(always)]
 pub fn pair_contact(p: &Particles, i: usize, j: usize, xj: V3, dt: f64) -> Option<(Contact, f64)> {
-    let d = p.x[i] - xj;
-    let r2 = d.norm_squared();
-    let (ri, rj) = (p.radius[i], p.radius[j]);
-    let radsum = ri + rj;
-    let r = r2.sqrt();
-    if r == 0.0 {
+    let r2 = (p.x[i] - xj).norm_squared();
+    if r2 == 0.0 {
         return None;
     }
-    // unit normal by one reciprocal (as LAMMPS and LIGGGHTS: rinv = 1/r)
-    let rinv = 1.0 / r;
-    let n = d * rinv;
-    let delta = radsum - r;
-    let mi = if p.frozen[i] { f64::INFINITY } else { p.mass[i] };
-    let mj = if p.frozen[j] { f64::INFINITY } else { p.mass[j] };
-    let m_eff = effective_mass(mi, mj);
-    let vr = p.v[i] - p.v[j];
+    let c = contact_lanes(&pair_state(p, i, j, xj), dt);
     let c = Contact {
-        n,
-        r,
-        delta,
-        ri,
-        rj,
-        r_eff: ri * rj / radsum,
-        mi,
-        mj,
-        m_eff,
-        vr,
-        vn: vr.dot(&n),
-        wi: p.omega[i],
-        wj: p.omega[j],
+        n: c.n.into(),
+        r: c.r,
+        delta: c.delta,
+        ri: c.ri,
+        rj: c.rj,
+        r_eff: c.r_eff,
+        mi: c.mi,
+        mj: c.mj,
+        m_eff: c.m_eff,
+        vr: c.vr.into(),
+        vn: c.vn,
+        wi: c.wi.into(),
+        wj: c.wj.into(),
         dt,
     };
     Some((c, r2))
@@ -150,14 +236,8 @@ pub fn pair_contact(p: &Particles, i: usize, j: usize, xj: V3, dt: f64) -> Optio
 
 /// m* = mi mj / (mi + mj), with an infinite mass on either side giving the other.
 #[inline(always)]
-pub fn effective_mass(mi: f64, mj: f64) -> f64 {
-    if mi.is_infinite() {
-        mj
-    } else if mj.is_infinite() {
-        mi
-    } else {
-        mi * mj / (mi + mj)
-    }
+pub fn effective_mass<L: Real>(mi: L, mj: L) -> L {
+    L::select(mi.is_inf(), mj, L::select(mj.is_inf(), mi, mi * mj / (mi + mj)))
 }
 
 impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: RollingLaw + Send> ContactKernel for Laws<N, T, C, R> {
@@ -181,28 +261,33 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         if defer.len() != m {
             defer.resize(m, [V3::zeros(); 2]);
         }
-        let PairList { a, b, shift, hist, block_start, .. } = pairs;
-        let (a, b, shift, block_start) = (&a[..], &b[..], &shift[..], &block_start[..]);
+        if pairs.live.len() != m {
+            pairs.live = vec![1; m];
+        }
+        let PairList { a, b, image, images, hist, live, block_start, .. } = pairs;
+        let (a, b, image, images, block_start) = (&a[..], &b[..], &image[..], &images[..], &block_start[..]);
         // split the pairs' history and deferred slots at the block ranges
         let nblocks = block_start.len().saturating_sub(1);
         let mut jobs = Vec::with_capacity(nblocks);
-        let (mut hrest, mut drest) = (&mut hist[..], &mut defer[..]);
+        let (mut hrest, mut drest, mut lrest) = (&mut hist[..], &mut defer[..], &mut live[..]);
         let (mut frest, mut trest) = (&mut force.f[..n], &mut force.torque[..n]);
         for q in 0..nblocks {
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
             let (h, hr) = std::mem::take(&mut hrest).split_at_mut((pe - ps) * w);
             let (d, dr) = std::mem::take(&mut drest).split_at_mut(pe - ps);
+            let (lv, lr) = std::mem::take(&mut lrest).split_at_mut(pe - ps);
+            lrest = lr;
             let len = bs.min(n - (q * bs).min(n));
             let (f, fr) = std::mem::take(&mut frest).split_at_mut(len);
             let (tq, tr) = std::mem::take(&mut trest).split_at_mut(len);
             (hrest, drest, frest, trest) = (hr, dr, fr, tr);
-            jobs.push((q, h, d, f, tq));
+            jobs.push((q, h, d, lv, f, tq));
         }
         let beyond = C::NONCONTACT || !N::CONTACT_ONLY;
         // one block: its pairs in increasing index; both shares of a pair
         // inside the block are added at once, the share of a particle of
         // another block is kept for the cross pass
-        let block = |(q, h, d, f, tq): (usize, &mut [f64], &mut [[V3; 2]], &mut [V3], &mut [V3])| -> f64 {
+        let block = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
             let lo = q * bs;
             let ps = block_start[q] as usize;
             let mut virial = 0.0;
@@ -213,8 +298,9 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                 if !own_j {
                     d[k - ps] = [V3::zeros(); 2];
                 }
+                lv[k - ps] = if own_j { 1 } else { 1 | DEFERRED };
                 let hk = &mut h[(k - ps) * w..(k - ps + 1) * w];
-                let xj = p.x[j] + shift[k];
+                let xj = p.x[j] + images[image[k] as usize];
                 let pp = table.get(p.kind[i], p.kind[j]);
                 // most listed pairs are within the skin but apart: decide on
                 // r^2 before building the contact (a normal law acting beyond
@@ -224,14 +310,17 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                     hk.fill(0.0);
                     continue;
                 }
-                let Some((c, _)) = pair_contact(p, i, j, xj, dt) else { continue };
+                let Some((c, _)) = pair_contact(p, i, j, xj, dt) else {
+                    continue;
+                };
                 if N::CONTACT_ONLY && (c.delta <= -pp.extra_range || (c.delta <= 0.0 && !C::NONCONTACT)) {
                     hk.fill(0.0);
                     continue;
                 }
                 let o = self.apply(&c, pp, hk);
                 let fi = o.force_i(&c);
-                virial += (p.x[i] - xj).dot(&fi);
+                // the lane form of the dot product, as the batched pass
+                virial += Vec3::from(p.x[i] - xj).dot(&Vec3::from(fi));
                 f[i - lo] += fi;
                 tq[i - lo] += o.torque_i;
                 if own_j {
@@ -243,8 +332,195 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             }
             virial
         };
-        let virials: Vec<f64> = if nblocks > 1 { jobs.into_par_iter().map(block).collect() } else { jobs.into_iter().map(block).collect() };
+        let batched = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
+            let blk = Block { p, a, b, image, images, table, dt, lo: q * bs, ps: block_start[q] as usize, pe: block_start[q + 1] as usize };
+            self.block_batched(&blk, h, d, lv, f, tq)
+        };
+        let virials: Vec<f64> = match (Self::BATCHED && !self.scalar_only(), nblocks > 1) {
+            (true, true) => jobs.into_par_iter().map(batched).collect(),
+            (true, false) => jobs.into_iter().map(batched).collect(),
+            (false, true) => jobs.into_par_iter().map(block).collect(),
+            (false, false) => jobs.into_iter().map(block).collect(),
+        };
         virials.iter().sum()
+    }
+}
+
+/// One block's share of the pass: its index, its pairs' history, deferred
+/// slots and live flags, and its particles' forces and torques.
+type Job<'a> = (usize, &'a mut [f64], &'a mut [[V3; 2]], &'a mut [u8], &'a mut [V3], &'a mut [V3]);
+
+/// Bit of `PairList::live`: the pair's share for its second particle was
+/// kept in the deferred slot this pass (cross-block pairs in contact); the
+/// cross pass adds only those.
+const DEFERRED: u8 = 2;
+
+/// Bit of `PairList::live` during a block's walk: the history may have
+/// been non-zero before this pass.
+const WAS_LIVE: u8 = 4;
+
+/// What a block of the batched pass reads.
+struct Block<'a> {
+    p: &'a Particles,
+    a: &'a [u32],
+    b: &'a [u32],
+    image: &'a [u8],
+    images: &'a [V3],
+    table: &'a ParamTable,
+    dt: f64,
+    /// First particle of the block.
+    lo: usize,
+    /// The block's pairs.
+    ps: usize,
+    pe: usize,
+}
+
+thread_local! {
+    /// Tests set it to run the per-contact pass where the batched one would
+    /// run, to check that both give the same bits.
+    static SCALAR_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Run `f` with the batched pair pass switched off on this thread (tests).
+pub fn with_scalar_pass<T>(f: impl FnOnce() -> T) -> T {
+    SCALAR_ONLY.with(|s| s.set(true));
+    let r = f();
+    SCALAR_ONLY.with(|s| s.set(false));
+    r
+}
+
+impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C, R> {
+    fn scalar_only(&self) -> bool {
+        SCALAR_ONLY.with(|s| s.get())
+    }
+
+    /// One block of the batched pass. The same contributions, added in the
+    /// same order, as the per-contact pass: pairs apart are sorted out one by
+    /// one, touching ones are queued in increasing index, and each full
+    /// queue runs the laws on [`LANES`] contacts at once and then adds the
+    /// lanes' forces in queue order.
+    #[inline(always)]
+    fn block_batched(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
+        let p = k.p;
+        let w = Self::WIDTH;
+        let mut queue = [0usize; LANES];
+        let mut queued = 0;
+        let mut virial = 0.0;
+        let pairs = k.a[k.ps..k.pe].iter().zip(&k.b[k.ps..k.pe]).zip(&k.image[k.ps..k.pe]);
+        for (q, ((&i, &j), &img)) in pairs.enumerate() {
+            let (i, j) = (i as usize, j as usize);
+            let xj = p.x[j] + k.images[img as usize];
+            let reach = p.radius[i] + p.radius[j];
+            let r2 = (p.x[i] - xj).norm_squared();
+            // no branch on touching, which is a coin toss for pairs in the
+            // skin: every pair is written to the queue, touching ones stay
+            let apart = r2 >= reach * reach;
+            let touch = !apart & (r2 != 0.0);
+            queue[queued] = k.ps + q;
+            queued += touch as usize;
+            // the flag's previous state moves to bit 2; pairs that came apart
+            // are cleared after the walk (rare; a branch here would not be)
+            lv[q] = ((lv[q] & 1) << 2) | (!apart) as u8;
+            if queued == LANES {
+                self.run_batch(k, &queue, LANES, h, d, lv, f, tq, &mut virial);
+                queued = 0;
+            }
+        }
+        if queued > 0 {
+            self.run_batch(k, &queue, queued, h, d, lv, f, tq, &mut virial);
+        }
+        for (q, l) in lv.iter_mut().enumerate() {
+            if *l & (WAS_LIVE | 1) == WAS_LIVE {
+                h[q * w..(q + 1) * w].fill(0.0);
+            }
+            *l &= !WAS_LIVE;
+        }
+        virial
+    }
+
+    /// Gather `count` queued pairs into lanes (the rest repeat the last one
+    /// and are dropped), run the laws, write history back and add forces in
+    /// queue order, and the lanes' virial to `virial`, in queue order.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn run_batch(
+        &self,
+        k: &Block<'_>,
+        queue: &[usize; LANES],
+        count: usize,
+        h: &mut [f64],
+        d: &mut [[V3; 2]],
+        lv: &mut [u8],
+        f: &mut [V3],
+        tq: &mut [V3],
+        virial: &mut f64,
+    ) {
+        let p = k.p;
+        let w = Self::WIDTH;
+        let z = Vec3::<F8>::zeros();
+        let zf = F8::splat(0.0);
+        let mut s = PairState { xi: z, xj: z, vi: z, vj: z, wi: z, wj: z, ri: zf, rj: zf, mi: zf, mj: zf };
+        let one_type = k.table.ntypes == 1;
+        let p0 = k.table.get(p.kind[k.a[queue[0]] as usize], p.kind[k.b[queue[0]] as usize]);
+        let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
+        let mut hist = [zf; 16];
+        let put = |v: &mut Vec3<F8>, l: usize, x: &V3| {
+            v.x.0[l] = x.x;
+            v.y.0[l] = x.y;
+            v.z.0[l] = x.z;
+        };
+        for l in 0..LANES {
+            let pk = queue[l.min(count - 1)];
+            let (i, j) = (k.a[pk] as usize, k.b[pk] as usize);
+            put(&mut s.xi, l, &p.x[i]);
+            put(&mut s.xj, l, &(p.x[j] + k.images[k.image[pk] as usize]));
+            put(&mut s.vi, l, &p.v[i]);
+            put(&mut s.vj, l, &p.v[j]);
+            put(&mut s.wi, l, &p.omega[i]);
+            put(&mut s.wj, l, &p.omega[j]);
+            s.ri.0[l] = p.radius[i];
+            s.rj.0[l] = p.radius[j];
+            s.mi.0[l] = if p.frozen[i] { f64::INFINITY } else { p.mass[i] };
+            s.mj.0[l] = if p.frozen[j] { f64::INFINITY } else { p.mass[j] };
+            if !one_type {
+                let pp = k.table.get(p.kind[i], p.kind[j]);
+                coeffs.uniform &= std::ptr::eq(pp, p0);
+                coeffs.p[l] = pp;
+            }
+            let hk = &h[(pk - k.ps) * w..(pk - k.ps + 1) * w];
+            for (m, v) in hk.iter().enumerate() {
+                hist[m].0[l] = *v;
+            }
+        }
+        let c = contact_lanes(&s, k.dt);
+        let o = self.apply_lanes(&c, &coeffs, &mut hist[..w]);
+        let fi = o.force_i(&c);
+        let vir = (s.xi - s.xj).dot(&fi);
+        for l in 0..count {
+            let pk = queue[l];
+            let (i, j) = (k.a[pk] as usize, k.b[pk] as usize);
+            let hk = &mut h[(pk - k.ps) * w..(pk - k.ps + 1) * w];
+            if c.delta.0[l] <= 0.0 {
+                // touching by r^2 but not by the overlap (rounding): apart
+                hk.fill(0.0);
+                lv[pk - k.ps] = 0;
+                continue;
+            }
+            for (m, v) in hk.iter_mut().enumerate() {
+                *v = hist[m].0[l];
+            }
+            let fl = fi.lane(l);
+            *virial += vir.0[l];
+            f[i - k.lo] += fl;
+            tq[i - k.lo] += o.torque_i.lane(l);
+            if j >= k.lo && j - k.lo < f.len() {
+                f[j - k.lo] -= fl;
+                tq[j - k.lo] += o.torque_j.lane(l);
+            } else {
+                d[pk - k.ps] = [fl, o.torque_j.lane(l)];
+                lv[pk - k.ps] |= DEFERRED;
+            }
+        }
     }
 }
 
@@ -273,6 +549,9 @@ pub fn cross_gather(pairs: &PairList, defer: &[[V3; 2]], f: &mut [V3], torque: &
             let i = ci * bs + q;
             let (s, e) = (pairs.cross_start[i] as usize, pairs.cross_start[i + 1] as usize);
             for &k in &pairs.cross[s..e] {
+                if pairs.live[k as usize] & DEFERRED == 0 {
+                    continue;
+                }
                 let o = &defer[k as usize];
                 fc[q] -= o[0];
                 tc[q] += o[1];
@@ -314,7 +593,16 @@ mod tests {
         for t in 1..=400 {
             s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             let u = |k: u32| ((s >> (k * 20)) & 0xfffff) as f64 / 1048576.0;
-            p.push(NewParticle { tag: t, kind: 1, mask: 1, x: V3::new(3.0 * u(0), 3.0 * u(1), 3.0 * u(2)), v: V3::zeros(), omega: V3::zeros(), radius: 0.12, density: 1.0 });
+            p.push(NewParticle {
+                tag: t,
+                kind: 1,
+                mask: 1,
+                x: V3::new(3.0 * u(0), 3.0 * u(1), 3.0 * u(2)),
+                v: V3::zeros(),
+                omega: V3::zeros(),
+                radius: 0.12,
+                density: 1.0,
+            });
         }
         let mut table = ParamTable::new(1);
         table.get_mut(1, 1).kn = 100.0;
@@ -350,5 +638,130 @@ mod tests {
         assert!(f1.iter().any(|f| f.norm() > 0.0));
         // history counted only for touching pairs
         assert!(h1.iter().all(|&v| v == 0.0 || v == 1.0));
+    }
+
+    /// A dense random packing of two sizes and two types, some particles
+    /// frozen, moving and spinning, in a periodic box.
+    fn random_bed(seed: u64) -> (Particles, Domain) {
+        let dom = Domain::new([0.0; 3], [2.0; 3], [[Side::Periodic; 2]; 3], 3);
+        let mut p = Particles::default();
+        let mut s = seed;
+        let mut u = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for t in 1..=600 {
+            let x = V3::new(2.0 * u(), 2.0 * u(), 2.0 * u());
+            let v = V3::new(u() - 0.5, u() - 0.5, u() - 0.5);
+            let w = V3::new(u() - 0.5, u() - 0.5, u() - 0.5) * 10.0;
+            let radius = if u() < 0.5 { 0.1 } else { 0.08 };
+            p.push(NewParticle { tag: t, kind: 1 + (u() < 0.3) as u32, mask: 1, x, v, omega: w, radius, density: 1.0 + u() });
+        }
+        for i in (0..p.len()).step_by(17) {
+            p.frozen[i] = true;
+        }
+        (p, dom)
+    }
+
+    /// Several passes of `laws` (positions advanced by the velocities in
+    /// between, so history builds up and pairs come apart); forces, torques,
+    /// history and virial of each pass.
+    fn passes<K: ContactKernel>(laws: &K, table: &ParamTable, scalar: bool) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
+        let (mut p, dom) = random_bed(11);
+        let mut pl = PairList { block: 128, ..Default::default() };
+        let settings = NeighSettings { skin: 0.05, ..Default::default() };
+        let mut out = vec![];
+        for step in 0..4 {
+            pl.build(&p, &dom, &settings, step, laws.history_width(), |_, _| 0.0);
+            let mut defer = vec![];
+            let mut f = vec![V3::zeros(); p.len()];
+            let mut t = vec![V3::zeros(); p.len()];
+            let pass = |f: &mut Vec<V3>, t: &mut Vec<V3>, defer: &mut Vec<[V3; 2]>, pl: &mut PairList| {
+                let w = laws.force_pass(&p, pl, table, 1e-3, Forces { f, torque: t, defer });
+                cross_gather(pl, defer, f, t);
+                w
+            };
+            let w = if scalar { with_scalar_pass(|| pass(&mut f, &mut t, &mut defer, &mut pl)) } else { pass(&mut f, &mut t, &mut defer, &mut pl) };
+            let bits = |v: &[V3]| v.iter().flat_map(|x| x.iter().map(|c| c.to_bits())).collect::<Vec<u64>>();
+            out.push((bits(&f), bits(&t), pl.hist.iter().map(|h| h.to_bits()).collect(), w.to_bits()));
+            for i in 0..p.len() {
+                let v = p.v[i];
+                p.x[i] += v * 0.01;
+            }
+        }
+        out
+    }
+
+    fn two_type_table(fill: impl Fn(&mut PairParams, u32)) -> ParamTable {
+        let mut table = ParamTable::new(2);
+        for (a, b) in [(1, 1), (1, 2), (2, 1), (2, 2)] {
+            fill(table.get_mut(a, b), a + b);
+        }
+        table
+    }
+
+    #[test]
+    fn batched_pass_gives_the_per_contact_bits() {
+        use crate::physics::normal::gran::LammpsGranHooke;
+        use crate::physics::normal::hertz::LiggghtsHertz;
+        use crate::physics::tangential::gran::LammpsGranHistory;
+        use crate::physics::tangential::history::LiggghtsHistory;
+        // LIGGGHTS hertz + history; small mu on one type pair so that some
+        // contacts slide and some stick
+        let laws = Laws { normal: LiggghtsHertz, tangential: LiggghtsHistory, cohesion: NoCohesion, rolling: NoRolling };
+        assert!(Laws::<LiggghtsHertz, LiggghtsHistory, NoCohesion, NoRolling>::BATCHED);
+        let table = two_type_table(|q, s| {
+            q.y_eff = 1e4 * s as f64;
+            q.g_eff = 4e3 * s as f64;
+            q.beta = -0.2;
+            q.mu = if s == 3 { 0.05 } else { 0.5 };
+            q.tangential_damping = 1.0;
+            q.limit_damping = if s == 4 { 1.0 } else { 0.0 };
+        });
+        let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
+        for (st, (b, s)) in batched.iter().zip(&scalar).enumerate() {
+            for (n, (x, y)) in [(&b.0, &s.0), (&b.1, &s.1), (&b.2, &s.2)].iter().enumerate() {
+                if let Some(q) = x.iter().zip(y.iter()).position(|(u, v)| u != v) {
+                    eprintln!("step {st} array {n} index {q}: {} vs {}", f64::from_bits(x[q]), f64::from_bits(y[q]));
+                }
+            }
+            if b.3 != s.3 {
+                eprintln!("step {st} virial {} vs {}", f64::from_bits(b.3), f64::from_bits(s.3));
+            }
+        }
+        assert_eq!(batched, scalar);
+        let contacts = scalar.last().unwrap().2.chunks(3).filter(|h| h.iter().any(|&v| v != 0)).count();
+        assert!(contacts > 100, "only {contacts} contacts with history");
+        // LAMMPS gran/hooke/history
+        let laws = Laws { normal: LammpsGranHooke, tangential: LammpsGranHistory, cohesion: NoCohesion, rolling: NoRolling };
+        let table = two_type_table(|q, s| {
+            q.kn = 1e4 * s as f64;
+            q.kt = 3e3 * s as f64;
+            q.gamma_n = 50.0;
+            q.gamma_t = if s == 3 { 0.0 } else { 25.0 };
+            q.mu = if s == 3 { 0.05 } else { 0.5 };
+        });
+        assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
+        // LIGGGHTS hertz + history + cohesion sjkr + rolling_friction epsd2
+        use crate::physics::cohesion::sjkr::LiggghtsSjkr;
+        use crate::physics::rolling::epsd2::LiggghtsEpsd2;
+        let laws = Laws {
+            normal: LiggghtsHertz,
+            tangential: LiggghtsHistory,
+            cohesion: LiggghtsSjkr { tangential_reduce: true },
+            rolling: LiggghtsEpsd2 { torsion_torque: false },
+        };
+        let table = two_type_table(|q, s| {
+            q.y_eff = 1e4 * s as f64;
+            q.g_eff = 4e3 * s as f64;
+            q.beta = -0.2;
+            q.mu = 0.5;
+            q.mu_r = if s == 3 { 0.01 } else { 0.3 };
+            q.cohesion = 1e3;
+            q.tangential_damping = 1.0;
+        });
+        let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
+        assert_eq!(batched, scalar);
+        assert!(scalar.last().unwrap().1.iter().any(|&t| t != 0));
     }
 }

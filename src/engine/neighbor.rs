@@ -44,8 +44,16 @@ pub struct PairList {
     pub a: Vec<u32>,
     /// Second particle.
     pub b: Vec<u32>,
-    /// Periodic shift added to b's position: b is seen at `x[b] + shift`.
-    pub shift: Vec<V3>,
+    /// Periodic image of each pair: b is seen at `x[b] + images[image[k]]`
+    /// (one byte per pair instead of a 24-byte shift; see [`PairList::shift`]).
+    pub image: Vec<u8>,
+    /// The distinct periodic shifts the pairs use.
+    pub images: Vec<V3>,
+    /// Per pair: 1 if its history may be non-zero (bit 0; the force pass
+    /// uses two more bits while it runs). A pair found apart with 0 here is
+    /// skipped without touching its history: most listed pairs are within
+    /// the skin but apart, and stay so.
+    pub live: Vec<u8>,
     /// History values, `width` per pair.
     pub hist: Vec<f64>,
     /// History values per pair.
@@ -135,6 +143,25 @@ impl PairList {
     pub fn len(&self) -> usize {
         self.a.len()
     }
+    /// The periodic shift of pair `k`: b is seen at `x[b] + shift(k)`.
+    #[inline(always)]
+    pub fn shift(&self, k: usize) -> V3 {
+        self.images[self.image[k] as usize]
+    }
+    /// Set the pairs' shifts from one vector per pair (a restart).
+    pub fn set_shifts(&mut self, shifts: &[V3]) {
+        self.images.clear();
+        self.image = shifts
+            .iter()
+            .map(|s| match self.images.iter().position(|t| t == s) {
+                Some(k) => k as u8,
+                None => {
+                    self.images.push(*s);
+                    (self.images.len() - 1) as u8
+                }
+            })
+            .collect();
+    }
     /// Whether there are no pairs.
     pub fn is_empty(&self) -> bool {
         self.a.is_empty()
@@ -184,8 +211,13 @@ impl PairList {
 
         self.a.clear();
         self.b.clear();
-        self.shift.clear();
+        self.image.clear();
         self.width = width;
+        let lens = dom.lengths();
+        // the 27 images a cell stencil reaches, indexed by the cell shift
+        self.images = (0..27)
+            .map(|c: i64| V3::new((c % 3 - 1) as f64 * lens[0], ((c / 3) % 3 - 1) as f64 * lens[1], (c / 9 - 1) as f64 * lens[2]))
+            .collect();
 
         if n > 0 {
             let rmax = p.radius.iter().cloned().fold(0.0, f64::max);
@@ -207,14 +239,14 @@ impl PairList {
             }
             let cut = 2.0 * rmax + s.skin + emax;
             let grid = Grid::new(p, dom, cut);
-            let lens = dom.lengths();
             for i in 0..n {
                 let ci = grid.cell_of(&p.x[i]);
                 for dz in -1i64..=1 {
                     for dy in -1i64..=1 {
                         for dx in -1i64..=1 {
                             let Some((cell, sh)) = grid.neighbor_cell(ci, [dx, dy, dz]) else { continue };
-                            let shift = V3::new(sh[0] as f64 * lens[0], sh[1] as f64 * lens[1], sh[2] as f64 * lens[2]);
+                            let img = (sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1);
+                            let shift = self.images[img as usize];
                             for &j in grid.members(cell) {
                                 let j = j as usize;
                                 let self_image = i == j;
@@ -233,11 +265,12 @@ impl PairList {
                                 if p.tag[i] <= p.tag[j] {
                                     self.a.push(i as u32);
                                     self.b.push(j as u32);
-                                    self.shift.push(shift);
+                                    self.image.push(img as u8);
                                 } else {
+                                    // the opposite image: -shift, exactly
                                     self.a.push(j as u32);
                                     self.b.push(i as u32);
-                                    self.shift.push(-shift);
+                                    self.image.push(26 - img as u8);
                                 }
                             }
                         }
@@ -253,11 +286,11 @@ impl PairList {
         order.sort_unstable_by(|&u, &v| {
             (self.a[u], self.b[u])
                 .cmp(&(self.a[v], self.b[v]))
-                .then_with(|| cmp_v3(&self.shift[u], &self.shift[v]))
+                .then_with(|| cmp_v3(&self.shift(u), &self.shift(v)))
         });
         self.a = order.iter().map(|&k| self.a[k]).collect();
         self.b = order.iter().map(|&k| self.b[k]).collect();
-        self.shift = order.iter().map(|&k| self.shift[k]).collect();
+        self.image = order.iter().map(|&k| self.image[k]).collect();
 
         self.keys = (0..m).map(|k| (p.tag[self.a[k] as usize], p.tag[self.b[k] as usize])).collect();
         // history
@@ -289,6 +322,8 @@ impl PairList {
     /// pairs of each particle. Called after every build and after a restart.
     pub fn index(&mut self, n: usize) {
         let m = self.a.len();
+        let w = self.width;
+        self.live = (0..m).map(|k| self.hist[k * w..(k + 1) * w].iter().any(|&v| v != 0.0) as u8).collect();
         // adjacency (CSR), pairs in increasing index per particle
         let mut count = vec![0u32; n + 1];
         for k in 0..m {
@@ -586,7 +621,7 @@ mod tests {
         let l = dom.lengths();
         let mut got: Vec<(i64, i64, [i64; 3])> = (0..pl.len())
             .map(|k| {
-                let sh = pl.shift[k];
+                let sh = pl.shift(k);
                 let c = [(sh[0] / l[0]).round() as i64, (sh[1] / l[1]).round() as i64, (sh[2] / l[2]).round() as i64];
                 (p.tag[pl.a[k] as usize], p.tag[pl.b[k] as usize], c)
             })

@@ -354,7 +354,7 @@ pub fn max_overlap(sim: &Sim) -> f64 {
         if a >= p.len() || b >= p.len() {
             continue;
         }
-        let r = (p.x[a] - p.x[b] - sim.pairs.shift[k]).norm();
+        let r = (p.x[a] - p.x[b] - sim.pairs.shift(k)).norm();
         let delta = p.radius[a] + p.radius[b] - r;
         m = m.max(delta / p.radius[a].min(p.radius[b]));
     }

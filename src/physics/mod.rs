@@ -13,11 +13,14 @@
 //! Units: SI inside (or whatever consistent set the deck's `units` gives; the
 //! laws are unit-agnostic).
 
-pub mod normal;
-pub mod tangential;
 pub mod cohesion;
-pub mod rolling;
+pub mod lanes;
 pub mod mixing;
+pub mod normal;
+pub mod rolling;
+pub mod tangential;
+
+use lanes::{Coeffs, Real, Vec3};
 
 use nalgebra::Vector3;
 
@@ -201,6 +204,14 @@ pub trait NormalLaw: Sync {
     }
     /// Fill `fn_elastic`, `fn_damp`, `fn_for_friction`, `kn`, `kt`, `a`.
     fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+    /// Whether the law has a lane form ([`NormalLaw::normal_lanes`]); the
+    /// kernel batches contacts only when every law of the scene has one.
+    const LANES: bool = false;
+    /// [`NormalLaw::normal`] on lanes (one contact or a batch).
+    #[inline(always)]
+    fn normal_lanes<R: Real, P: Coeffs<R>>(&self, _c: &ContactL<R>, _p: &P, _hist: &mut [R], _out: &mut OutL<R>) {
+        unreachable!("law without a lane form")
+    }
 }
 
 /// A tangential (friction) law. Also applies the torque of the tangential
@@ -210,6 +221,13 @@ pub trait TangentialLaw: Sync {
     const HISTORY: usize;
     /// Fill `ft`, add to `torque_i`, `torque_j`.
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+    /// Whether the law has a lane form.
+    const LANES: bool = false;
+    /// [`TangentialLaw::tangential`] on lanes.
+    #[inline(always)]
+    fn tangential_lanes<R: Real, P: Coeffs<R>>(&self, _c: &ContactL<R>, _p: &P, _hist: &mut [R], _out: &mut OutL<R>) {
+        unreachable!("law without a lane form")
+    }
 }
 
 /// A cohesion law (adds to `fn_coh`).
@@ -221,6 +239,13 @@ pub trait CohesionLaw: Sync {
     const NONCONTACT: bool;
     /// Add the cohesive normal force.
     fn cohesion(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+    /// Whether the law has a lane form.
+    const LANES: bool = false;
+    /// [`CohesionLaw::cohesion`] on lanes.
+    #[inline(always)]
+    fn cohesion_lanes<R: Real, P: Coeffs<R>>(&self, _c: &ContactL<R>, _p: &P, _hist: &mut [R], _out: &mut OutL<R>) {
+        unreachable!("law without a lane form")
+    }
 }
 
 /// A rolling (and twisting) resistance law (adds torques).
@@ -229,6 +254,13 @@ pub trait RollingLaw: Sync {
     const HISTORY: usize;
     /// Add rolling/twisting torques to `torque_i` / `torque_j`.
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
+    /// Whether the law has a lane form.
+    const LANES: bool = false;
+    /// [`RollingLaw::rolling`] on lanes.
+    #[inline(always)]
+    fn rolling_lanes<R: Real, P: Coeffs<R>>(&self, _c: &ContactL<R>, _p: &P, _hist: &mut [R], _out: &mut OutL<R>) {
+        unreachable!("law without a lane form")
+    }
 }
 
 /// No cohesion: a zero-sized type, compiled away.
@@ -239,6 +271,9 @@ impl CohesionLaw for NoCohesion {
     const NONCONTACT: bool = false;
     #[inline(always)]
     fn cohesion(&self, _: &Contact, _: &PairParams, _: &mut [f64], _: &mut ContactOut) {}
+    const LANES: bool = true;
+    #[inline(always)]
+    fn cohesion_lanes<R: Real, P: Coeffs<R>>(&self, _: &ContactL<R>, _: &P, _: &mut [R], _: &mut OutL<R>) {}
 }
 
 /// No rolling resistance: a zero-sized type, compiled away.
@@ -248,4 +283,167 @@ impl RollingLaw for NoRolling {
     const HISTORY: usize = 0;
     #[inline(always)]
     fn rolling(&self, _: &Contact, _: &PairParams, _: &mut [f64], _: &mut ContactOut) {}
+    const LANES: bool = true;
+    #[inline(always)]
+    fn rolling_lanes<R: Real, P: Coeffs<R>>(&self, _: &ContactL<R>, _: &P, _: &mut [R], _: &mut OutL<R>) {}
+}
+
+/// [`Contact`] on lanes: one contact (`R = f64`) or a batch of pair contacts
+/// ([`lanes::F8`]). Same fields and conventions; `wall` is one flag for all
+/// lanes (batches hold pairs only).
+#[derive(Clone, Copy, Debug)]
+pub struct ContactL<R> {
+    /// Unit normal from j to i.
+    pub n: Vec3<R>,
+    /// Centre distance.
+    pub r: R,
+    /// Overlap.
+    pub delta: R,
+    /// Radius of i.
+    pub ri: R,
+    /// Radius of j.
+    pub rj: R,
+    /// Effective radius.
+    pub r_eff: R,
+    /// Mass of i.
+    pub mi: R,
+    /// Mass of j.
+    pub mj: R,
+    /// Effective mass.
+    pub m_eff: R,
+    /// Relative centre velocity.
+    pub vr: Vec3<R>,
+    /// Normal relative speed.
+    pub vn: R,
+    /// Angular velocity of i.
+    pub wi: Vec3<R>,
+    /// Angular velocity of j.
+    pub wj: Vec3<R>,
+    /// Time step.
+    pub dt: f64,
+    /// Whether j is a wall (for every lane).
+    pub wall: bool,
+}
+
+impl ContactL<f64> {
+    /// One contact's lane form.
+    #[inline(always)]
+    pub fn one(c: &Contact) -> Self {
+        ContactL {
+            n: c.n.into(),
+            r: c.r,
+            delta: c.delta,
+            ri: c.ri,
+            rj: c.rj,
+            r_eff: c.r_eff,
+            mi: c.mi,
+            mj: c.mj,
+            m_eff: c.m_eff,
+            vr: c.vr.into(),
+            vn: c.vn,
+            wi: c.wi.into(),
+            wj: c.wj.into(),
+            dt: c.dt,
+            wall: c.is_wall(),
+        }
+    }
+}
+
+/// [`ContactOut`] on lanes.
+#[derive(Clone, Copy, Debug)]
+pub struct OutL<R> {
+    /// See [`ContactOut::fn_elastic`].
+    pub fn_elastic: R,
+    /// See [`ContactOut::fn_damp`].
+    pub fn_damp: R,
+    /// See [`ContactOut::fn_coh`].
+    pub fn_coh: R,
+    /// See [`ContactOut::fn_for_friction`].
+    pub fn_for_friction: R,
+    /// See [`ContactOut::kn`].
+    pub kn: R,
+    /// See [`ContactOut::kt`].
+    pub kt: R,
+    /// See [`ContactOut::a`].
+    pub a: R,
+    /// See [`ContactOut::gamma_n`].
+    pub gamma_n: R,
+    /// See [`ContactOut::gamma_t`].
+    pub gamma_t: R,
+    /// Tangential force on i.
+    pub ft: Vec3<R>,
+    /// Torque on i.
+    pub torque_i: Vec3<R>,
+    /// Torque on j.
+    pub torque_j: Vec3<R>,
+}
+
+impl<R: Real> OutL<R> {
+    /// All zero (as `ContactOut::default()`).
+    #[inline(always)]
+    pub fn zeros() -> Self {
+        let z = R::splat(0.0);
+        let v = Vec3::zeros();
+        OutL { fn_elastic: z, fn_damp: z, fn_coh: z, fn_for_friction: z, kn: z, kt: z, a: z, gamma_n: z, gamma_t: z, ft: v, torque_i: v, torque_j: v }
+    }
+    /// Total normal force along n.
+    #[inline(always)]
+    pub fn fn_total(&self) -> R {
+        self.fn_elastic + self.fn_damp + self.fn_coh
+    }
+    /// Total force on i.
+    #[inline(always)]
+    pub fn force_i(&self, c: &ContactL<R>) -> Vec3<R> {
+        c.n * self.fn_total() + self.ft
+    }
+}
+
+impl From<&ContactOut> for OutL<f64> {
+    #[inline(always)]
+    fn from(o: &ContactOut) -> Self {
+        OutL {
+            fn_elastic: o.fn_elastic,
+            fn_damp: o.fn_damp,
+            fn_coh: o.fn_coh,
+            fn_for_friction: o.fn_for_friction,
+            kn: o.kn,
+            kt: o.kt,
+            a: o.a,
+            gamma_n: o.gamma_n,
+            gamma_t: o.gamma_t,
+            ft: o.ft.into(),
+            torque_i: o.torque_i.into(),
+            torque_j: o.torque_j.into(),
+        }
+    }
+}
+
+impl From<OutL<f64>> for ContactOut {
+    #[inline(always)]
+    fn from(o: OutL<f64>) -> Self {
+        ContactOut {
+            fn_elastic: o.fn_elastic,
+            fn_damp: o.fn_damp,
+            fn_coh: o.fn_coh,
+            fn_for_friction: o.fn_for_friction,
+            kn: o.kn,
+            kt: o.kt,
+            a: o.a,
+            gamma_n: o.gamma_n,
+            gamma_t: o.gamma_t,
+            ft: o.ft.into(),
+            torque_i: o.torque_i.into(),
+            torque_j: o.torque_j.into(),
+        }
+    }
+}
+
+/// Run a lane-form law on one contact: the scalar entry point of a law that
+/// is written once on lanes.
+#[inline(always)]
+pub fn on_one(c: &Contact, out: &mut ContactOut, f: impl FnOnce(&ContactL<f64>, &mut OutL<f64>)) {
+    let cl = ContactL::one(c);
+    let mut o = OutL::from(&*out);
+    f(&cl, &mut o);
+    *out = o.into();
 }

@@ -121,7 +121,7 @@ impl RestartState {
             pair_width: sim.pairs.width,
             pair_a: sim.pairs.a.clone(),
             pair_b: sim.pairs.b.clone(),
-            pair_shift: sim.pairs.shift.iter().map(v3).collect(),
+            pair_shift: (0..sim.pairs.len()).map(|k| v3(&sim.pairs.shift(k))).collect(),
             adj_start: sim.pairs.adj_start.clone(),
             adj: sim.pairs.adj.clone(),
             x_built: sim.pairs.x_built.iter().map(v3).collect(),
@@ -223,7 +223,6 @@ impl RestartState {
         sim.pairs = crate::engine::neighbor::PairList {
             a: self.pair_a,
             b: self.pair_b,
-            shift: self.pair_shift.iter().map(a3).collect(),
             hist: self.pair_hist,
             width: self.pair_width,
             adj_start: self.adj_start,
@@ -235,6 +234,7 @@ impl RestartState {
             dangerous: 0,
             ..Default::default()
         };
+        sim.pairs.set_shifts(&self.pair_shift.iter().map(a3).collect::<Vec<_>>());
         sim.pairs.index(n);
         // continue exactly: the next run reuses the saved list and forces
         sim.force_rebuild = false;

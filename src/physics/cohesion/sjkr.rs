@@ -4,7 +4,8 @@
 //! (the circle where the two spheres intersect, sign flipped), wall
 //! A = pi (R^2 - d^2), d the centre distance.
 
-use crate::physics::{CohesionLaw, Contact, ContactOut, PairParams};
+use crate::physics::lanes::{Coeffs, Real};
+use crate::physics::{on_one, CohesionLaw, Contact, ContactL, ContactOut, OutL, PairParams};
 
 /// LIGGGHTS `cohesion sjkr`. Reads `cohesion` (energy density, J/m^3).
 #[derive(Clone, Copy, Debug, Default)]
@@ -18,15 +19,21 @@ impl CohesionLaw for LiggghtsSjkr {
     const HISTORY: usize = 0;
     const NONCONTACT: bool = false;
     #[inline(always)]
-    fn cohesion(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
+    fn cohesion(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
+        on_one(c, out, |c, o| self.cohesion_lanes(c, p, hist, o));
+    }
+    const LANES: bool = true;
+    #[inline(always)]
+    fn cohesion_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, _hist: &mut [R], out: &mut OutL<R>) {
+        use std::f64::consts::PI;
         let d = c.r;
-        let a_cont = if c.is_wall() {
-            std::f64::consts::PI * (c.ri * c.ri - d * d)
+        let a_cont = if c.wall {
+            (c.ri * c.ri - d * d) * PI
         } else {
             let (ri, rj) = (c.ri, c.rj);
-            -std::f64::consts::PI / 4.0 * ((d - ri - rj) * (d + ri - rj) * (d - ri + rj) * (d + ri + rj)) / (d * d)
+            ((d - ri - rj) * (d + ri - rj) * (d - ri + rj) * (d + ri + rj)) * (-PI / 4.0) / (d * d)
         };
-        let f_coh = -p.cohesion * a_cont;
+        let f_coh = -p.get(|q| q.cohesion) * a_cont;
         out.fn_coh += f_coh;
         if self.tangential_reduce {
             out.fn_for_friction += f_coh;

@@ -7,7 +7,8 @@
 //! gamma_t = -2 sqrt(5/6) beta sqrt(S_t m*) (0 with `tangential_damping off`),
 //! F_n = k_n delta_n - gamma_n v_n.
 
-use crate::physics::{Contact, ContactOut, NormalLaw, PairParams};
+use crate::physics::lanes::{Coeffs, Real};
+use crate::physics::{on_one, Contact, ContactL, ContactOut, NormalLaw, OutL, PairParams};
 
 /// sqrt(5/6), the LIGGGHTS Hertz damping prefactor.
 pub(crate) const SQRT_FIVE_SIXTHS: f64 = 0.912_870_929_175_276_9;
@@ -20,17 +21,23 @@ pub struct LiggghtsHertz;
 
 impl NormalLaw for LiggghtsHertz {
     const HISTORY: usize = 0;
+    const LANES: bool = true;
     #[inline(always)]
-    fn normal(&self, c: &Contact, p: &PairParams, _hist: &mut [f64], out: &mut ContactOut) {
+    fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
+        on_one(c, out, |c, o| self.normal_lanes(c, p, hist, o));
+    }
+    #[inline(always)]
+    fn normal_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, _hist: &mut [R], out: &mut OutL<R>) {
         let delta_n = c.delta;
+        let (y_eff, g_eff, beta) = (p.get(|q| q.y_eff), p.get(|q| q.g_eff), p.get(|q| q.beta));
         let s = (c.r_eff * delta_n).sqrt();
-        let s_n = 2.0 * p.y_eff * s;
-        let s_t = 8.0 * p.g_eff * s;
-        let k_n = 4.0 / 3.0 * p.y_eff * s;
+        let s_n = y_eff * 2.0 * s;
+        let s_t = g_eff * 8.0 * s;
+        let k_n = y_eff * (4.0 / 3.0) * s;
         let k_t = s_t;
-        let gamma_n = -2.0 * SQRT_FIVE_SIXTHS * p.beta * (s_n * c.m_eff).sqrt();
-        let gamma_t = -2.0 * SQRT_FIVE_SIXTHS * p.beta * (s_t * c.m_eff).sqrt() * p.tangential_damping;
-        super::store_normal(out, k_n * delta_n, -gamma_n * c.vn, p.limit_damping);
+        let gamma_n = beta * (-2.0 * SQRT_FIVE_SIXTHS) * (s_n * c.m_eff).sqrt();
+        let gamma_t = beta * (-2.0 * SQRT_FIVE_SIXTHS) * (s_t * c.m_eff).sqrt() * p.get(|q| q.tangential_damping);
+        super::store_normal_lanes(out, k_n * delta_n, -gamma_n * c.vn, p.get(|q| q.limit_damping));
         out.kn = k_n;
         out.kt = k_t;
         out.a = s;

@@ -12,17 +12,18 @@
 //! `a`, `gamma_n` and `gamma_t` (the absolute tangential damping coefficient
 //! the tangential laws of the same engine read).
 
-pub mod hooke;
-pub mod hooke_stiffness;
-pub mod hertz;
-pub mod hertz_stiffness;
+pub mod dmt;
 pub mod gran;
 pub mod granular;
-pub mod dmt;
+pub mod hertz;
+pub mod hertz_stiffness;
+pub mod hooke;
+pub mod hooke_stiffness;
 pub mod jkr;
 pub mod viscoelastic;
 
-use super::ContactOut;
+use super::lanes::{Mask, Real};
+use super::{ContactOut, OutL};
 
 /// Store elastic and damping parts, clamping the sum at zero when
 /// `limit` (LIGGGHTS `limitForce on`, LAMMPS `limit_damping`) is set and the
@@ -33,6 +34,17 @@ pub(crate) fn store_normal(out: &mut ContactOut, fn_elastic: f64, fn_damp: f64, 
     if limit != 0.0 && fn_elastic + damp < 0.0 {
         damp = -fn_elastic;
     }
+    out.fn_elastic = fn_elastic;
+    out.fn_damp = damp;
+    out.fn_for_friction = fn_elastic + damp;
+}
+
+/// [`store_normal`] on lanes.
+#[inline(always)]
+pub(crate) fn store_normal_lanes<R: Real>(out: &mut OutL<R>, fn_elastic: R, fn_damp: R, limit: R) {
+    let zero = R::splat(0.0);
+    let clamp = limit.ne(zero).and((fn_elastic + fn_damp).lt(zero));
+    let damp = R::select(clamp, -fn_elastic, fn_damp);
     out.fn_elastic = fn_elastic;
     out.fn_damp = damp;
     out.fn_for_friction = fn_elastic + damp;

@@ -1,8 +1,9 @@
 //! LIGGGHTS `rolling_friction epsd2` (source `rolling_model_epsd2.h`,
 //! Iwashita & Oda): k_r = k_t R^2, cap mu_r R |F_n|, no dashpot.
 
-use super::{epsd_torque, liggghts_rotation};
-use crate::physics::{Contact, ContactOut, PairParams, RollingLaw};
+use super::{epsd_torque_lanes, liggghts_rotation_lanes};
+use crate::physics::lanes::{Coeffs, Real};
+use crate::physics::{on_one, Contact, ContactL, ContactOut, OutL, PairParams, RollingLaw};
 
 /// LIGGGHTS `rolling_friction epsd2`. Reads `mu_r`; `out.kt`,
 /// `out.fn_for_friction`. History: the spring torque (3).
@@ -16,8 +17,13 @@ impl RollingLaw for LiggghtsEpsd2 {
     const HISTORY: usize = 3;
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
-        let (w, r) = liggghts_rotation(c);
+        on_one(c, out, |c, o| self.rolling_lanes(c, p, hist, o));
+    }
+    const LANES: bool = true;
+    #[inline(always)]
+    fn rolling_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, hist: &mut [R], out: &mut OutL<R>) {
+        let (w, r) = liggghts_rotation_lanes(c);
         let k_r = out.kt * r * r;
-        epsd_torque(c, p, hist, out, k_r, 0.0, self.torsion_torque, r, w);
+        epsd_torque_lanes(c, p, hist, out, k_r, R::splat(0.0), self.torsion_torque, r, w);
     }
 }

@@ -18,15 +18,23 @@ pub mod sds;
 pub mod marshall;
 pub mod paper;
 
-use super::{Contact, ContactOut, PairParams, V3};
-use super::tangential::{get3, put3};
+use super::lanes::{Coeffs, Real, Vec3};
+use super::tangential::{get3_lanes, put3_lanes};
+use super::{on_one, Contact, ContactL, ContactOut, OutL, PairParams, V3};
 
 /// LIGGGHTS relative rotation and rolling radius of a contact:
 /// (w_i - w_j, R*) for pairs, ((R - delta/2)/d w_i, R) for walls.
 #[inline(always)]
 pub(crate) fn liggghts_rotation(c: &Contact) -> (V3, f64) {
-    if c.is_wall() {
-        (c.wi * ((c.ri - 0.5 * c.delta) / c.r), c.ri)
+    let (w, r) = liggghts_rotation_lanes(&ContactL::one(c));
+    (w.into(), r)
+}
+
+/// [`liggghts_rotation`] on lanes.
+#[inline(always)]
+pub(crate) fn liggghts_rotation_lanes<R: Real>(c: &ContactL<R>) -> (Vec3<R>, R) {
+    if c.wall {
+        (c.wi * ((c.ri - c.delta * 0.5) / c.r), c.ri)
     } else {
         (c.wi - c.wj, c.r_eff)
     }
@@ -60,19 +68,34 @@ pub(crate) fn epsd_torque(
     r_roll: f64,
     w_rel: V3,
 ) {
+    on_one(c, out, |c, o| epsd_torque_lanes(c, p, hist, o, k_r, r_coef, torsion, r_roll, w_rel.into()));
+}
+
+/// [`epsd_torque`] on lanes: the one implementation.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn epsd_torque_lanes<R: Real, P: Coeffs<R>>(
+    c: &ContactL<R>,
+    p: &P,
+    hist: &mut [R],
+    out: &mut OutL<R>,
+    k_r: R,
+    r_coef: R,
+    torsion: bool,
+    r_roll: R,
+    w_rel: Vec3<R>,
+) {
     let w = if torsion { w_rel } else { w_rel - c.n * w_rel.dot(&c.n) };
-    let mut m = get3(hist) + w * (c.dt * k_r);
-    let m_max = out.fn_for_friction.abs() * r_roll * p.mu_r;
+    let m = get3_lanes(hist) + w * (k_r * c.dt);
+    let m_max = out.fn_for_friction.abs() * r_roll * p.get(|q| q.mu_r);
     let m_mag = m.norm();
-    if m_mag > m_max {
-        m *= m_max / m_mag;
-        put3(hist, &m);
-    } else {
-        put3(hist, &m);
-        m += w * r_coef;
-    }
+    // over the cap: the spring torque scaled onto it and no dashpot
+    let capped = m_mag.gt(m_max);
+    let m_cap = m * (m_max / m_mag);
+    put3_lanes(hist, &Vec3::select(capped, m_cap, m));
+    let m = Vec3::select(capped, m_cap, m + w * r_coef);
     out.torque_i -= m;
-    if !c.is_wall() {
+    if !c.wall {
         out.torque_j += m;
     }
 }

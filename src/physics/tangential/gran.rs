@@ -10,8 +10,9 @@
 //! and relative rotation use the full radii R_i, R_j.
 
 use super::no_history::capped_viscous;
-use super::{add_tangential_torque, get3, put3, rel_tangential_velocity};
-use crate::physics::{Contact, ContactOut, PairParams, TangentialLaw, V3};
+use super::{add_tangential_torque, add_tangential_torque_lanes, get3_lanes, put3_lanes, rel_tangential_velocity, rel_tangential_velocity_lanes};
+use crate::physics::lanes::{Coeffs, Mask, Real, Vec3};
+use crate::physics::{on_one, Contact, ContactL, ContactOut, OutL, PairParams, TangentialLaw};
 
 /// LAMMPS `gran/hooke/history` and `gran/hertz/history` shear history.
 /// Reads `mu`; `out.kt`, `out.gamma_t`, `out.fn_for_friction`.
@@ -26,33 +27,36 @@ fn rj_lever(c: &Contact) -> f64 {
 
 impl TangentialLaw for LammpsGranHistory {
     const HISTORY: usize = 3;
+    const LANES: bool = true;
     #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
-        let vtr = rel_tangential_velocity(c, c.ri, rj_lever(c));
-        let mut xi = get3(hist) + vtr * c.dt;
+        on_one(c, out, |c, o| self.tangential_lanes(c, p, hist, o));
+    }
+    #[inline(always)]
+    fn tangential_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, hist: &mut [R], out: &mut OutL<R>) {
+        let vtr = rel_tangential_velocity_lanes(c, c.ri, c.rj);
+        let mut xi = get3_lanes(hist) + vtr * R::splat(c.dt);
         // LAMMPS takes the magnitude before the projection (zero test only).
         let shrmag = xi.norm();
         xi -= c.n * xi.dot(&c.n);
         let k_t = out.kt;
         let g_t = out.gamma_t;
-        let mut fs: V3 = -(xi * k_t + vtr * g_t);
+        let fs = -(xi * k_t + vtr * g_t);
         let fs_mag = fs.norm();
-        let f_cap = p.mu * out.fn_for_friction.abs();
-        if fs_mag > f_cap {
-            if shrmag != 0.0 {
-                let ratio = f_cap / fs_mag;
-                if k_t != 0.0 {
-                    let mgkt = g_t / k_t;
-                    xi = (xi + vtr * mgkt) * ratio - vtr * mgkt;
-                }
-                fs *= ratio;
-            } else {
-                fs = V3::zeros();
-            }
-        }
-        put3(hist, &xi);
+        let f_cap = p.get(|q| q.mu) * out.fn_for_friction.abs();
+        // slip: the total force scaled onto the cap and the spring set so that
+        // spring and damping give it
+        let zero = R::splat(0.0);
+        let slide = fs_mag.gt(f_cap);
+        let moved = shrmag.ne(zero);
+        let ratio = f_cap / fs_mag;
+        let mgkt = g_t / k_t;
+        let xi_slip = (xi + vtr * mgkt) * ratio - vtr * mgkt;
+        xi = Vec3::select(slide.and(moved).and(k_t.ne(zero)), xi_slip, xi);
+        let fs = Vec3::select(slide, Vec3::select(moved, fs * ratio, Vec3::zeros()), fs);
+        put3_lanes(hist, &xi);
         out.ft = fs;
-        add_tangential_torque(c, &fs, c.ri, rj_lever(c), out);
+        add_tangential_torque_lanes(c, &fs, c.ri, c.rj, out);
     }
 }
 

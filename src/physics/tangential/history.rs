@@ -7,8 +7,9 @@
 //! F_t = F_el - gamma_t v_t. Relative velocity and torque use the
 //! contact-point distance R - delta/2 of each sphere (`surface_model_default.h`).
 
-use super::{add_tangential_torque, get3, liggghts_levers, put3, rel_tangential_velocity};
-use crate::physics::{Contact, ContactOut, PairParams, TangentialLaw, V3};
+use super::{add_tangential_torque_lanes, get3_lanes, liggghts_levers_lanes, put3_lanes, rel_tangential_velocity_lanes};
+use crate::physics::lanes::{Coeffs, Mask, Real, Vec3};
+use crate::physics::{on_one, Contact, ContactL, ContactOut, OutL, PairParams, TangentialLaw};
 
 /// LIGGGHTS `tangential history`. History: the shear displacement xi (3).
 /// Reads `mu`; `out.kt`, `out.gamma_t`, `out.fn_for_friction`.
@@ -17,29 +18,32 @@ pub struct LiggghtsHistory;
 
 impl TangentialLaw for LiggghtsHistory {
     const HISTORY: usize = 3;
+    const LANES: bool = true;
     #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
-        let (cri, crj) = liggghts_levers(c);
-        let vtr = rel_tangential_velocity(c, cri, crj);
-        let mut xi = get3(hist) + vtr * c.dt;
+        on_one(c, out, |c, o| self.tangential_lanes(c, p, hist, o));
+    }
+    #[inline(always)]
+    fn tangential_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, hist: &mut [R], out: &mut OutL<R>) {
+        let (cri, crj) = liggghts_levers_lanes(c);
+        let vtr = rel_tangential_velocity_lanes(c, cri, crj);
+        let mut xi = get3_lanes(hist) + vtr * R::splat(c.dt);
         xi -= c.n * xi.dot(&c.n);
         let k_t = out.kt;
         let shrmag = xi.norm();
-        let mut ft: V3 = -xi * k_t;
+        let ft_el = -xi * k_t;
         let ft_shear = k_t * shrmag;
-        let ft_friction = p.mu * out.fn_for_friction.abs();
-        if ft_shear > ft_friction {
-            if shrmag != 0.0 {
-                ft *= ft_friction / ft_shear;
-                xi = -ft / k_t;
-            } else {
-                ft = V3::zeros();
-            }
-        } else {
-            ft -= vtr * out.gamma_t;
-        }
-        put3(hist, &xi);
+        let ft_friction = p.get(|q| q.mu) * out.fn_for_friction.abs();
+        // sliding: the elastic force scaled onto the cap, the spring reset to
+        // it, no damping; sticking: elastic plus damping
+        let slide = ft_shear.gt(ft_friction);
+        let moved = shrmag.ne(R::splat(0.0));
+        let ft_slide = ft_el * (ft_friction / ft_shear);
+        let ft_stick = ft_el - vtr * out.gamma_t;
+        let ft = Vec3::select(slide, Vec3::select(moved, ft_slide, Vec3::zeros()), ft_stick);
+        xi = Vec3::select(slide.and(moved), -ft_slide / k_t, xi);
+        put3_lanes(hist, &xi);
         out.ft = ft;
-        add_tangential_torque(c, &ft, cri, crj, out);
+        add_tangential_torque_lanes(c, &ft, cri, crj, out);
     }
 }

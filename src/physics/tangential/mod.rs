@@ -11,13 +11,14 @@
 //! All laws read `out.fn_for_friction`, `out.kt` and `out.gamma_t` (or
 //! `out.gamma_n` for LAMMPS granular) written by the normal law.
 
-pub mod no_history;
-pub mod history;
 pub mod gran;
 pub mod granular;
+pub mod history;
+pub mod no_history;
 pub mod paper;
 
-use super::{Contact, ContactOut, V3};
+use super::lanes::{Real, Vec3};
+use super::{Contact, ContactL, ContactOut, OutL, V3};
 
 /// Relative tangential velocity of the contact points,
 /// `v_t - (l_i w_i + l_j w_j) x n`, with lever radii `l_i`, `l_j` (the wall
@@ -63,4 +64,46 @@ pub(crate) fn put3(h: &mut [f64], v: &V3) {
 #[inline(always)]
 pub(crate) fn get3(h: &[f64]) -> V3 {
     V3::new(h[0], h[1], h[2])
+}
+
+/// [`rel_tangential_velocity`] on lanes.
+#[inline(always)]
+pub fn rel_tangential_velocity_lanes<R: Real>(c: &ContactL<R>, lever_i: R, lever_j: R) -> Vec3<R> {
+    let vt = c.vr - c.n * c.vn;
+    let mut wr = c.wi * lever_i;
+    if !c.wall {
+        wr += c.wj * lever_j;
+    }
+    vt - wr.cross(&c.n)
+}
+
+/// [`add_tangential_torque`] on lanes.
+#[inline(always)]
+pub fn add_tangential_torque_lanes<R: Real>(c: &ContactL<R>, ft: &Vec3<R>, lever_i: R, lever_j: R, out: &mut OutL<R>) {
+    let tor = c.n.cross(ft);
+    out.torque_i -= tor * lever_i;
+    if !c.wall {
+        out.torque_j -= tor * lever_j;
+    }
+}
+
+/// [`liggghts_levers`] on lanes.
+#[inline(always)]
+pub fn liggghts_levers_lanes<R: Real>(c: &ContactL<R>) -> (R, R) {
+    let half = c.delta * 0.5;
+    (c.ri - half, c.rj - half)
+}
+
+/// Read a 3-vector of lanes from history lanes.
+#[inline(always)]
+pub(crate) fn get3_lanes<R: Real>(h: &[R]) -> Vec3<R> {
+    Vec3::new(h[0], h[1], h[2])
+}
+
+/// Store a 3-vector of lanes into history lanes.
+#[inline(always)]
+pub(crate) fn put3_lanes<R: Real>(h: &mut [R], v: &Vec3<R>) {
+    h[0] = v.x;
+    h[1] = v.y;
+    h[2] = v.z;
 }
