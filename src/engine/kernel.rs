@@ -763,5 +763,16 @@ mod tests {
         let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
         assert_eq!(batched, scalar);
         assert!(scalar.last().unwrap().1.iter().any(|&t| t != 0));
+        // LIGGGHTS hooke (k_n from the characteristic velocity) + history
+        use crate::physics::normal::hooke::LiggghtsHooke;
+        let laws = Laws { normal: LiggghtsHooke { kt_to_kn: true }, tangential: LiggghtsHistory, cohesion: NoCohesion, rolling: NoRolling };
+        let table = two_type_table(|q, s| {
+            q.y_eff = 1e4 * s as f64;
+            q.beta = -0.2;
+            q.char_vel = 0.5;
+            q.mu = 0.3;
+            q.tangential_damping = 1.0;
+        });
+        assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
     }
 }

@@ -62,6 +62,8 @@ pub trait Real:
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
     /// A mask from one flag for all lanes.
     fn mask(b: bool) -> Self::Mask;
+    /// `self^e` (the scalar library power, lane by lane).
+    fn powf(self, e: f64) -> Self;
 }
 
 impl Mask for bool {
@@ -120,6 +122,10 @@ impl Real for f64 {
     #[inline(always)]
     fn mask(b: bool) -> bool {
         b
+    }
+    #[inline(always)]
+    fn powf(self, e: f64) -> f64 {
+        f64::powf(self, e)
     }
 }
 
@@ -282,6 +288,14 @@ impl Real for F8 {
     #[inline(always)]
     fn mask(b: bool) -> M8 {
         M8([b; LANES])
+    }
+    #[inline(always)]
+    fn powf(self, e: f64) -> F8 {
+        let mut r = self.0;
+        for v in &mut r {
+            *v = v.powf(e);
+        }
+        F8(r)
     }
 }
 
