@@ -214,24 +214,7 @@ pub fn pair_contact(p: &Particles, i: usize, j: usize, xj: V3, dt: f64) -> Optio
     if r2 == 0.0 {
         return None;
     }
-    let c = contact_lanes(&pair_state(p, i, j, xj), dt);
-    let c = Contact {
-        n: c.n.into(),
-        r: c.r,
-        delta: c.delta,
-        ri: c.ri,
-        rj: c.rj,
-        r_eff: c.r_eff,
-        mi: c.mi,
-        mj: c.mj,
-        m_eff: c.m_eff,
-        vr: c.vr.into(),
-        vn: c.vn,
-        wi: c.wi.into(),
-        wj: c.wj.into(),
-        dt,
-    };
-    Some((c, r2))
+    Some((contact_lanes(&pair_state(p, i, j, xj), dt).into(), r2))
 }
 
 /// m* = mi mj / (mi + mj), with an infinite mass on either side giving the other.

@@ -325,27 +325,42 @@ pub struct ContactL<R> {
     pub wall: bool,
 }
 
+/// The fields of a contact, moved between [`Contact`] and
+/// [`ContactL`]`<f64>` (vectors converted), plus any the target adds.
+macro_rules! convert_contact {
+    ($c:expr, $to:ident { $($extra:tt)* }) => {
+        $to {
+            n: $c.n.into(),
+            r: $c.r,
+            delta: $c.delta,
+            ri: $c.ri,
+            rj: $c.rj,
+            r_eff: $c.r_eff,
+            mi: $c.mi,
+            mj: $c.mj,
+            m_eff: $c.m_eff,
+            vr: $c.vr.into(),
+            vn: $c.vn,
+            wi: $c.wi.into(),
+            wj: $c.wj.into(),
+            dt: $c.dt,
+            $($extra)*
+        }
+    };
+}
+
 impl ContactL<f64> {
     /// One contact's lane form.
     #[inline(always)]
     pub fn one(c: &Contact) -> Self {
-        ContactL {
-            n: c.n.into(),
-            r: c.r,
-            delta: c.delta,
-            ri: c.ri,
-            rj: c.rj,
-            r_eff: c.r_eff,
-            mi: c.mi,
-            mj: c.mj,
-            m_eff: c.m_eff,
-            vr: c.vr.into(),
-            vn: c.vn,
-            wi: c.wi.into(),
-            wj: c.wj.into(),
-            dt: c.dt,
-            wall: c.is_wall(),
-        }
+        convert_contact!(c, ContactL { wall: c.is_wall() })
+    }
+}
+
+impl From<ContactL<f64>> for Contact {
+    #[inline(always)]
+    fn from(c: ContactL<f64>) -> Self {
+        convert_contact!(c, Contact {})
     }
 }
 
@@ -398,43 +413,38 @@ impl<R: Real> OutL<R> {
     }
 }
 
+/// The fields of a contact's output, moved between [`ContactOut`] and
+/// [`OutL`]`<f64>` (vectors converted).
+macro_rules! convert_out {
+    ($o:expr, $to:ident) => {
+        $to {
+            fn_elastic: $o.fn_elastic,
+            fn_damp: $o.fn_damp,
+            fn_coh: $o.fn_coh,
+            fn_for_friction: $o.fn_for_friction,
+            kn: $o.kn,
+            kt: $o.kt,
+            a: $o.a,
+            gamma_n: $o.gamma_n,
+            gamma_t: $o.gamma_t,
+            ft: $o.ft.into(),
+            torque_i: $o.torque_i.into(),
+            torque_j: $o.torque_j.into(),
+        }
+    };
+}
+
 impl From<&ContactOut> for OutL<f64> {
     #[inline(always)]
     fn from(o: &ContactOut) -> Self {
-        OutL {
-            fn_elastic: o.fn_elastic,
-            fn_damp: o.fn_damp,
-            fn_coh: o.fn_coh,
-            fn_for_friction: o.fn_for_friction,
-            kn: o.kn,
-            kt: o.kt,
-            a: o.a,
-            gamma_n: o.gamma_n,
-            gamma_t: o.gamma_t,
-            ft: o.ft.into(),
-            torque_i: o.torque_i.into(),
-            torque_j: o.torque_j.into(),
-        }
+        convert_out!(o, OutL)
     }
 }
 
 impl From<OutL<f64>> for ContactOut {
     #[inline(always)]
     fn from(o: OutL<f64>) -> Self {
-        ContactOut {
-            fn_elastic: o.fn_elastic,
-            fn_damp: o.fn_damp,
-            fn_coh: o.fn_coh,
-            fn_for_friction: o.fn_for_friction,
-            kn: o.kn,
-            kt: o.kt,
-            a: o.a,
-            gamma_n: o.gamma_n,
-            gamma_t: o.gamma_t,
-            ft: o.ft.into(),
-            torque_i: o.torque_i.into(),
-            torque_j: o.torque_j.into(),
-        }
+        convert_out!(o, ContactOut)
     }
 }
 
