@@ -757,5 +757,17 @@ mod tests {
             q.tangential_damping = 1.0;
         });
         assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
+        // LIGGGHTS hooke/stiffness + history
+        use crate::physics::normal::hooke_stiffness::LiggghtsHookeStiffness;
+        let laws = Laws { normal: LiggghtsHookeStiffness { absolute_damping: false }, tangential: LiggghtsHistory, cohesion: NoCohesion, rolling: NoRolling };
+        let table = two_type_table(|q, s| {
+            q.kn = 1e4 * s as f64;
+            q.kt = 3e3 * s as f64;
+            q.gamma_n = 40.0;
+            q.gamma_t = 20.0;
+            q.mu = 0.3;
+            q.tangential_damping = 1.0;
+        });
+        assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
     }
 }
