@@ -9,6 +9,7 @@
 //! index, so forces can be gathered in a fixed order on any thread count.
 
 use super::domain::Domain;
+use super::integrate::CHUNK;
 use super::particles::Particles;
 use crate::physics::V3;
 use std::collections::HashMap;
@@ -180,7 +181,14 @@ impl PairList {
             return true;
         }
         let lim = 0.25 * s.skin * s.skin;
-        let moved = p.x.iter().zip(&self.x_built).any(|(x, x0)| (x - x0).norm_squared() > lim);
+        // a yes/no over all particles: the same answer on any thread count
+        let moved_in = |x: &[V3], x0: &[V3]| x.iter().zip(x0).any(|(x, x0)| (x - x0).norm_squared() > lim);
+        let moved = if p.len() >= 2 * CHUNK {
+            use rayon::prelude::*;
+            p.x.par_chunks(CHUNK).zip(self.x_built.par_chunks(CHUNK)).any(|(x, x0)| moved_in(x, x0))
+        } else {
+            moved_in(&p.x, &self.x_built)
+        };
         if moved && since == s.delay.max(1) && s.delay > 0 {
             self.dangerous += 1;
         }

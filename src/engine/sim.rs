@@ -241,11 +241,13 @@ impl Sim {
     /// history while `update->setupflag` is set).
     fn pair_forces_dt(&mut self, dt: f64) {
         let p = &mut self.particles;
-        for f in p.f.iter_mut() {
-            *f = V3::zeros();
-        }
-        for t in p.torque.iter_mut() {
-            *t = V3::zeros();
+        if p.len() >= 2 * super::integrate::CHUNK {
+            use rayon::prelude::*;
+            p.f.par_chunks_mut(super::integrate::CHUNK).for_each(|c| c.fill(V3::zeros()));
+            p.torque.par_chunks_mut(super::integrate::CHUNK).for_each(|c| c.fill(V3::zeros()));
+        } else {
+            p.f.fill(V3::zeros());
+            p.torque.fill(V3::zeros());
         }
         self.pair_virial = 0.0;
         if let Some(m) = &self.model {

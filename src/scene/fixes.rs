@@ -114,12 +114,22 @@ impl Fix for Gravity {
             self.acc = self.dir * m;
         }
         let p = &mut sim.particles;
-        for i in 0..p.len() {
-            if p.mask[i] & self.group != 0 {
-                // LAMMPS FixGravity: f += rmass * xacc (per component)
-                let m = p.mass[i];
-                p.f[i] += V3::new(m * self.acc.x, m * self.acc.y, m * self.acc.z);
+        let (acc, group) = (self.acc, self.group);
+        // each particle on its own: the same bits on any thread count
+        let pull = |f: &mut [V3], mask: &[u32], mass: &[f64]| {
+            for ((f, &bits), &m) in f.iter_mut().zip(mask).zip(mass) {
+                if bits & group != 0 {
+                    // LAMMPS FixGravity: f += rmass * xacc (per component)
+                    *f += V3::new(m * acc.x, m * acc.y, m * acc.z);
+                }
             }
+        };
+        let chunk = integrate::CHUNK;
+        if p.len() >= 2 * chunk {
+            use rayon::prelude::*;
+            p.f.par_chunks_mut(chunk).zip(p.mask.par_chunks(chunk)).zip(p.mass.par_chunks(chunk)).for_each(|((f, mask), mass)| pull(f, mask, mass));
+        } else {
+            pull(&mut p.f, &p.mask, &p.mass);
         }
         Ok(())
     }
