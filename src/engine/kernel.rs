@@ -85,7 +85,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     const WIDTH: usize = N::HISTORY + C::HISTORY + T::HISTORY + R::HISTORY;
     /// Whether the pair pass runs the laws on batches of [`LANES`] contacts:
     /// every law has a lane form and acts only on touching pairs.
-    const BATCHED: bool = N::LANES && T::LANES && C::LANES && R::LANES && N::CONTACT_ONLY && !C::NONCONTACT && Self::WIDTH <= 16;
+    const BATCHED: bool = N::LANES && T::LANES && C::LANES && R::LANES && N::CONTACT_ONLY && !C::NONCONTACT && Self::WIDTH <= MAX_BATCH_HISTORY;
 
     /// The laws on a batch of touching contacts, in the fixed order.
     #[inline(always)]
@@ -183,16 +183,19 @@ pub fn contact_lanes<L: Real>(s: &PairState<L>, dt: f64) -> ContactL<L> {
     }
 }
 
+/// A particle's mass as its contacts see it: infinite when frozen.
+#[inline(always)]
+fn contact_mass(p: &Particles, k: usize) -> f64 {
+    if p.frozen[k] {
+        f64::INFINITY
+    } else {
+        p.mass[k]
+    }
+}
+
 /// The state of pair (i, j) of one contact, j seen at `xj`.
 #[inline(always)]
 fn pair_state(p: &Particles, i: usize, j: usize, xj: V3) -> PairState<f64> {
-    let mass = |k: usize| {
-        if p.frozen[k] {
-            f64::INFINITY
-        } else {
-            p.mass[k]
-        }
-    };
     PairState {
         xi: p.x[i].into(),
         xj: xj.into(),
@@ -202,8 +205,8 @@ fn pair_state(p: &Particles, i: usize, j: usize, xj: V3) -> PairState<f64> {
         wj: p.omega[j].into(),
         ri: p.radius[i],
         rj: p.radius[j],
-        mi: mass(i),
-        mj: mass(j),
+        mi: contact_mass(p, i),
+        mj: contact_mass(p, j),
     }
 }
 
@@ -333,6 +336,10 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
 /// slots and live flags, and its particles' forces and torques.
 type Job<'a> = (usize, &'a mut [f64], &'a mut [[V3; 2]], &'a mut [u8], &'a mut [V3], &'a mut [V3]);
 
+/// History values per contact the batched pass holds in lanes; wider
+/// combinations take the per-contact pass.
+const MAX_BATCH_HISTORY: usize = 16;
+
 /// Bit of `PairList::live`: the pair's share for its second particle was
 /// kept in the deferred slot this pass (cross-block pairs in contact); the
 /// cross pass adds only those.
@@ -446,7 +453,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let one_type = k.table.ntypes == 1;
         let p0 = k.table.get(p.kind[k.a[queue[0]] as usize], p.kind[k.b[queue[0]] as usize]);
         let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
-        let mut hist = [zf; 16];
+        let mut hist = [zf; MAX_BATCH_HISTORY];
         let put = |v: &mut Vec3<F8>, l: usize, x: &V3| {
             v.x.0[l] = x.x;
             v.y.0[l] = x.y;
@@ -463,8 +470,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             put(&mut s.wj, l, &p.omega[j]);
             s.ri.0[l] = p.radius[i];
             s.rj.0[l] = p.radius[j];
-            s.mi.0[l] = if p.frozen[i] { f64::INFINITY } else { p.mass[i] };
-            s.mj.0[l] = if p.frozen[j] { f64::INFINITY } else { p.mass[j] };
+            s.mi.0[l] = contact_mass(p, i);
+            s.mj.0[l] = contact_mass(p, j);
             if !one_type {
                 let pp = k.table.get(p.kind[i], p.kind[j]);
                 coeffs.uniform &= std::ptr::eq(pp, p0);

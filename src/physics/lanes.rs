@@ -20,10 +20,6 @@ pub const LANES: usize = 8;
 pub trait Mask: Copy {
     /// Both.
     fn and(self, o: Self) -> Self;
-    /// Either.
-    fn or(self, o: Self) -> Self;
-    /// Not.
-    fn not(self) -> Self;
 }
 
 /// A float or a batch of floats.
@@ -60,8 +56,6 @@ pub trait Real:
     fn is_inf(self) -> Self::Mask;
     /// `a` where `m`, else `b`.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
-    /// A mask from one flag for all lanes.
-    fn mask(b: bool) -> Self::Mask;
     /// `self^e` (the scalar library power, lane by lane).
     fn powf(self, e: f64) -> Self;
 }
@@ -70,14 +64,6 @@ impl Mask for bool {
     #[inline(always)]
     fn and(self, o: bool) -> bool {
         self & o
-    }
-    #[inline(always)]
-    fn or(self, o: bool) -> bool {
-        self | o
-    }
-    #[inline(always)]
-    fn not(self) -> bool {
-        !self
     }
 }
 
@@ -120,10 +106,6 @@ impl Real for f64 {
         }
     }
     #[inline(always)]
-    fn mask(b: bool) -> bool {
-        b
-    }
-    #[inline(always)]
     fn powf(self, e: f64) -> f64 {
         f64::powf(self, e)
     }
@@ -162,22 +144,6 @@ impl Mask for M8 {
         let mut r = self.0;
         for l in 0..LANES {
             r[l] &= o.0[l];
-        }
-        M8(r)
-    }
-    #[inline(always)]
-    fn or(self, o: M8) -> M8 {
-        let mut r = self.0;
-        for l in 0..LANES {
-            r[l] |= o.0[l];
-        }
-        M8(r)
-    }
-    #[inline(always)]
-    fn not(self) -> M8 {
-        let mut r = self.0;
-        for v in &mut r {
-            *v = !*v;
         }
         M8(r)
     }
@@ -284,10 +250,6 @@ impl Real for F8 {
             }
         }
         F8(r)
-    }
-    #[inline(always)]
-    fn mask(b: bool) -> M8 {
-        M8([b; LANES])
     }
     #[inline(always)]
     fn powf(self, e: f64) -> F8 {
