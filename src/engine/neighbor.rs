@@ -93,6 +93,111 @@ pub struct PairList {
 /// particle, and so every bit of the result, is the same on any thread count.
 pub const BLOCK: usize = 2048;
 
+/// History of the previous list, for the next build (see
+/// [`PairList::carry_source`]).
+enum Carry {
+    None,
+    /// Storage unchanged: the old pairs of particle `i` are
+    /// `start[i]..start[i + 1]`, sorted by `b`.
+    ByIndex { start: Vec<u32>, b: Vec<u32>, hist: Vec<f64> },
+    /// Non-zero history by id pair.
+    ById(HashMap<(i64, i64), Vec<f64>, BuildHasherDefault<IdHasher>>),
+}
+
+/// The pairs whose first particle lies in `lo..lo + count.len()`.
+struct Chunk {
+    lo: usize,
+    count: Vec<u32>,
+    b: Vec<u32>,
+    image: Vec<u8>,
+    hist: Vec<f64>,
+}
+
+/// What the per-chunk build reads.
+struct BuildCtx<'a, F> {
+    p: &'a Particles,
+    s: &'a NeighSettings,
+    grid: &'a Grid,
+    images: &'a [V3],
+    extra_range: &'a F,
+    old: &'a Carry,
+    width: usize,
+}
+
+impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
+    fn chunk(&self, range: std::ops::Range<usize>) -> Chunk {
+        let (p, s, w) = (self.p, self.s, self.width);
+        let mut out = Chunk { lo: range.start, count: Vec::with_capacity(range.len()), b: vec![], image: vec![], hist: vec![] };
+        let mut found: Vec<(u32, u8)> = Vec::new();
+        let mut stencil: Vec<(usize, u8, bool)> = Vec::with_capacity(27);
+        let mut stencil_of: Option<[i64; 3]> = None;
+        for i in range {
+            let ci = self.grid.cell_of(&p.x[i]);
+            if stencil_of != Some(ci) {
+                stencil.clear();
+                for dz in -1i64..=1 {
+                    for dy in -1i64..=1 {
+                        for dx in -1i64..=1 {
+                            if let Some((cell, sh)) = self.grid.neighbor_cell(ci, [dx, dy, dz]) {
+                                let img = (sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1);
+                                stencil.push((cell, img as u8, positive(sh)));
+                            }
+                        }
+                    }
+                }
+                stencil_of = Some(ci);
+            }
+            let (ti, xi, ri) = (p.tag[i], p.x[i], p.radius[i]);
+            // branch-free: every candidate is written, and the slot is kept
+            // when the pair is listed (the id test is a coin toss per
+            // candidate, so a branch on it mispredicts half the time)
+            let most: usize = stencil.iter().map(|&(cell, _, _)| self.grid.members(cell).len()).sum();
+            found.resize(most, (0, 0));
+            let mut len = 0;
+            for &(cell, img, pos) in &stencil {
+                let shift = self.images[img as usize];
+                for &j in self.grid.members(cell) {
+                    let ju = j as usize;
+                    // each pair once, from its smaller id; a particle's own
+                    // periodic images once, by the positive shift
+                    let tj = p.tag[ju];
+                    let order = (tj > ti) | ((tj == ti) & pos);
+                    let d = xi - (p.x[ju] + shift);
+                    let reach = ri + p.radius[ju] + s.skin + (self.extra_range)(i, ju);
+                    let within = d.norm_squared() < reach * reach;
+                    found[len] = (j, img);
+                    len += (order & within) as usize;
+                }
+            }
+            found.truncate(len);
+            if !s.exclude_types.is_empty() || !s.exclude_groups.is_empty() {
+                found.retain(|&(j, _)| j as usize == i || !s.excluded(p, i, j as usize));
+            }
+            // by storage index, then shift (periodic images of one pair)
+            found.sort_unstable_by(|u, v| u.0.cmp(&v.0).then_with(|| cmp_v3(&self.images[u.1 as usize], &self.images[v.1 as usize])));
+            out.count.push(found.len() as u32);
+            for &(j, img) in &found {
+                out.b.push(j);
+                out.image.push(img);
+            }
+            let h0 = out.hist.len();
+            out.hist.resize(h0 + found.len() * w, 0.0);
+            if let Carry::ByIndex { start, b, hist } = self.old {
+                let old = start[i] as usize..start[i + 1] as usize;
+                for (k, &(j, _)) in found.iter().enumerate() {
+                    // the last old pair (i, j) with non-zero history, as the
+                    // by-id map keeps it
+                    let from = old.clone().filter(|&q| b[q] == j).filter(|&q| hist[q * w..(q + 1) * w].iter().any(|&v| v != 0.0)).last();
+                    if let Some(q) = from {
+                        out.hist[h0 + k * w..h0 + (k + 1) * w].copy_from_slice(&hist[q * w..(q + 1) * w]);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
 /// Marker bit in `PairList::adj` for "this particle is b".
 pub const ADJ_B: u32 = 1 << 31;
 
@@ -195,125 +300,114 @@ impl PairList {
         moved
     }
 
-    /// Build the list. `range(i, j)` is how far beyond touching the pair
-    /// interacts (0 for contact-only models). History of pairs present before
-    /// is carried over by id.
+    /// Build the list. `extra_range(i, j)` is how far beyond touching the
+    /// pair interacts (0 for contact-only models). History of pairs present
+    /// before is carried over by id.
+    ///
+    /// Each particle collects, over the full 27-cell stencil, the neighbours
+    /// of larger id (and its own positive periodic images), sorted by storage
+    /// index and shift: so the list comes out ordered by (a, b, shift) with no
+    /// global sort, and fixed chunks of particles are built in parallel and
+    /// joined in order (the same list on any thread count).
     pub fn build<F>(&mut self, p: &Particles, dom: &Domain, s: &NeighSettings, step: i64, width: usize, extra_range: F)
     where
-        F: Fn(usize, usize) -> f64,
+        F: Fn(usize, usize) -> f64 + Sync,
     {
+        use rayon::prelude::*;
         let n = p.len();
-        // --- carry old history by id pair
-        let mut old: HashMap<(i64, i64), usize, BuildHasherDefault<IdHasher>> = HashMap::default();
-        if self.width == width && width > 0 {
-            for k in 0..self.a.len() {
-                let h = &self.hist[k * width..(k + 1) * width];
-                if h.iter().any(|&v| v != 0.0) {
-                    if let Some(&key) = self.keys.get(k) {
-                        old.insert(key, k);
-                    }
-                }
-            }
-        }
-        let old_hist = std::mem::take(&mut self.hist);
-
-        self.a.clear();
-        self.b.clear();
-        self.image.clear();
-        self.width = width;
         let lens = dom.lengths();
         // the 27 images a cell stencil reaches, indexed by the cell shift
-        self.images = (0..27)
+        let images: Vec<V3> = (0..27)
             .map(|c: i64| V3::new((c % 3 - 1) as f64 * lens[0], ((c / 3) % 3 - 1) as f64 * lens[1], (c / 9 - 1) as f64 * lens[2]))
             .collect();
-
+        let carry = self.carry_source(p, width);
+        let mut chunks: Vec<Chunk> = Vec::new();
         if n > 0 {
             let rmax = p.radius.iter().cloned().fold(0.0, f64::max);
-            let mut emax: f64 = 0.0;
-            // extra range is per type pair; sample the maximum over present types
-            let mut types: Vec<u32> = p.kind.clone();
-            types.sort_unstable();
-            types.dedup();
-            let mut rep: Vec<usize> = Vec::new();
-            for &t in &types {
-                if let Some(i) = p.kind.iter().position(|&k| k == t) {
-                    rep.push(i);
+            // extra range is per type pair: its maximum over the present types
+            let mut rep: Vec<(u32, usize)> = Vec::new();
+            for (i, &t) in p.kind.iter().enumerate() {
+                if !rep.iter().any(|&(u, _)| u == t) {
+                    rep.push((t, i));
                 }
             }
-            for &i in &rep {
-                for &j in &rep {
-                    emax = emax.max(extra_range(i, j));
-                }
-            }
-            let cut = 2.0 * rmax + s.skin + emax;
-            let grid = Grid::new(p, dom, cut);
-            for i in 0..n {
-                let ci = grid.cell_of(&p.x[i]);
-                for dz in -1i64..=1 {
-                    for dy in -1i64..=1 {
-                        for dx in -1i64..=1 {
-                            let Some((cell, sh)) = grid.neighbor_cell(ci, [dx, dy, dz]) else { continue };
-                            let img = (sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1);
-                            let shift = self.images[img as usize];
-                            for &j in grid.members(cell) {
-                                let j = j as usize;
-                                let self_image = i == j;
-                                if j < i || (self_image && !positive(sh)) {
-                                    continue;
-                                }
-                                let d = p.x[i] - (p.x[j] + shift);
-                                let reach = p.radius[i] + p.radius[j] + s.skin + extra_range(i, j);
-                                if d.norm_squared() >= reach * reach {
-                                    continue;
-                                }
-                                if !self_image && s.excluded(p, i, j) {
-                                    continue;
-                                }
-                                // smaller id first; the shift applies to the second
-                                if p.tag[i] <= p.tag[j] {
-                                    self.a.push(i as u32);
-                                    self.b.push(j as u32);
-                                    self.image.push(img as u8);
-                                } else {
-                                    // the opposite image: -shift, exactly
-                                    self.a.push(j as u32);
-                                    self.b.push(i as u32);
-                                    self.image.push(26 - img as u8);
-                                }
-                            }
-                        }
-                    }
-                }
-            }
+            let emax = rep.iter().flat_map(|&(_, i)| rep.iter().map(move |&(_, j)| (i, j))).map(|(i, j)| extra_range(i, j)).fold(0.0, f64::max);
+            let grid = Grid::new(p, dom, 2.0 * rmax + s.skin + emax);
+            let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width };
+            let nchunks = n.div_ceil(CHUNK);
+            chunks = if nchunks > 1 {
+                (0..nchunks).into_par_iter().map(|c| ctx.chunk(c * CHUNK..((c + 1) * CHUNK).min(n))).collect()
+            } else {
+                vec![ctx.chunk(0..n)]
+            };
         }
-        // deterministic pair order: by (a, b) storage index, then shift
-        let m = self.a.len();
-        let mut order: Vec<usize> = (0..m).collect();
-        // (a, b) is unique except for periodic images of one pair: unstable
-        // sorting with the shift as the last key is still deterministic
-        order.sort_unstable_by(|&u, &v| {
-            (self.a[u], self.b[u])
-                .cmp(&(self.a[v], self.b[v]))
-                .then_with(|| cmp_v3(&self.shift(u), &self.shift(v)))
-        });
-        self.a = order.iter().map(|&k| self.a[k]).collect();
-        self.b = order.iter().map(|&k| self.b[k]).collect();
-        self.image = order.iter().map(|&k| self.image[k]).collect();
-
-        self.keys = (0..m).map(|k| (p.tag[self.a[k] as usize], p.tag[self.b[k] as usize])).collect();
-        // history
-        self.hist = vec![0.0; m * width];
-        if !old.is_empty() {
+        let m: usize = chunks.iter().map(|c| c.b.len()).sum();
+        let mut a = Vec::with_capacity(m);
+        let mut b = Vec::with_capacity(m);
+        let mut image = Vec::with_capacity(m);
+        let mut hist = Vec::with_capacity(m * width);
+        for c in &chunks {
+            for (k, &cnt) in c.count.iter().enumerate() {
+                a.extend(std::iter::repeat_n((c.lo + k) as u32, cnt as usize));
+            }
+            b.extend_from_slice(&c.b);
+            image.extend_from_slice(&c.image);
+            hist.extend_from_slice(&c.hist);
+        }
+        if let Carry::ById(old) = &carry {
+            // storage changed since the last build: match history by id pair
             for k in 0..m {
-                if let Some(&ok) = old.get(&self.keys[k]) {
-                    self.hist[k * width..(k + 1) * width].copy_from_slice(&old_hist[ok * width..(ok + 1) * width]);
+                if let Some(h) = old.get(&(p.tag[a[k] as usize], p.tag[b[k] as usize])) {
+                    hist[k * width..(k + 1) * width].copy_from_slice(h);
                 }
             }
         }
+        self.keys = a.iter().zip(&b).map(|(&i, &j)| (p.tag[i as usize], p.tag[j as usize])).collect();
+        self.a = a;
+        self.b = b;
+        self.image = image;
+        self.images = images;
+        self.hist = hist;
+        self.width = width;
         self.index(n);
         self.x_built = p.x.clone();
         self.last_build = step;
         self.builds += 1;
+    }
+
+    /// Where the next build finds the history of pairs listed now: by storage
+    /// index when every pair's stored ids still match the particles at its
+    /// indices (nothing was inserted, deleted or reordered since), by id pair
+    /// otherwise. Only pairs with some non-zero history are carried.
+    fn carry_source(&mut self, p: &Particles, width: usize) -> Carry {
+        if self.width != width || width == 0 || self.a.is_empty() {
+            return Carry::None;
+        }
+        let n = p.len();
+        let same = self.keys.len() == self.a.len()
+            && self.a.iter().zip(&self.b).zip(&self.keys).all(|((&i, &j), &key)| {
+                (i as usize) < n && (j as usize) < n && (p.tag[i as usize], p.tag[j as usize]) == key
+            });
+        if same {
+            let mut start = vec![0u32; n + 1];
+            for &i in &self.a {
+                start[i as usize + 1] += 1;
+            }
+            for i in 0..n {
+                start[i + 1] += start[i];
+            }
+            return Carry::ByIndex { start, b: std::mem::take(&mut self.b), hist: std::mem::take(&mut self.hist) };
+        }
+        let mut old: HashMap<(i64, i64), Vec<f64>, BuildHasherDefault<IdHasher>> = HashMap::default();
+        for (k, h) in self.hist.chunks_exact(width).enumerate() {
+            if h.iter().any(|&v| v != 0.0) {
+                if let Some(&key) = self.keys.get(k) {
+                    // of two images of one pair, the later one is kept
+                    old.insert(key, h.to_vec());
+                }
+            }
+        }
+        Carry::ById(old)
     }
 
     /// Particles per force block.
