@@ -242,16 +242,16 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         let bs = pairs.block_size();
         let n = p.len();
         let defer = force.defer;
-        // slots are written before they are read (cross pairs only), so the
-        // buffer is not cleared
-        if defer.len() != m {
-            defer.resize(m, [V3::zeros(); 2]);
+        // one slot per cross pair; each block clears its slots first
+        let ncross = pairs.block_cross.last().copied().unwrap_or(0) as usize;
+        if defer.len() != ncross {
+            defer.resize(ncross, [V3::zeros(); 2]);
         }
         if pairs.live.len() != m {
             pairs.live = vec![1; m];
         }
-        let PairList { a, b, image, images, hist, live, block_start, .. } = pairs;
-        let (a, b, image, images, block_start) = (&a[..], &b[..], &image[..], &images[..], &block_start[..]);
+        let PairList { a, b, image, images, hist, live, block_start, block_cross, cslot, .. } = pairs;
+        let (a, b, image, images, block_start, cslot) = (&a[..], &b[..], &image[..], &images[..], &block_start[..], &cslot[..]);
         // split the pairs' history and deferred slots at the block ranges
         let nblocks = block_start.len().saturating_sub(1);
         let mut jobs = Vec::with_capacity(nblocks);
@@ -260,7 +260,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         for q in 0..nblocks {
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
             let (h, hr) = std::mem::take(&mut hrest).split_at_mut((pe - ps) * w);
-            let (d, dr) = std::mem::take(&mut drest).split_at_mut(pe - ps);
+            let (d, dr) = std::mem::take(&mut drest).split_at_mut((block_cross[q + 1] - block_cross[q]) as usize);
             let (lv, lr) = std::mem::take(&mut lrest).split_at_mut(pe - ps);
             lrest = lr;
             let len = bs.min(n - (q * bs).min(n));
@@ -276,15 +276,14 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         let block = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
             let lo = q * bs;
             let ps = block_start[q] as usize;
+            let base = block_cross[q] as usize;
+            d.fill([V3::zeros(); 2]);
             let mut virial = 0.0;
             for k in ps..block_start[q + 1] as usize {
                 let i = a[k] as usize;
                 let j = b[k] as usize;
                 let own_j = j >= lo && j - lo < f.len();
-                if !own_j {
-                    d[k - ps] = [V3::zeros(); 2];
-                }
-                lv[k - ps] = if own_j { 1 } else { 1 | DEFERRED };
+                lv[k - ps] = 1;
                 let hk = &mut h[(k - ps) * w..(k - ps + 1) * w];
                 let xj = p.x[j] + images[image[k] as usize];
                 let pp = table.get(p.kind[i], p.kind[j]);
@@ -313,13 +312,15 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                     f[j - lo] -= fi;
                     tq[j - lo] += o.torque_j;
                 } else {
-                    d[k - ps] = [fi, o.torque_j];
+                    d[cslot[k] as usize - base] = [fi, o.torque_j];
                 }
             }
             virial
         };
         let batched = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
-            let blk = Block { p, a, b, image, images, table, dt, lo: q * bs, ps: block_start[q] as usize, pe: block_start[q + 1] as usize };
+            let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
+            d.fill([V3::zeros(); 2]);
+            let blk = Block { p, a, b, image, images, cslot, base: block_cross[q] as usize, table, dt, lo: q * bs, ps, pe };
             self.block_batched(&blk, h, d, lv, f, tq)
         };
         let virials: Vec<f64> = match (Self::BATCHED && !self.scalar_only(), nblocks > 1) {
@@ -340,11 +341,6 @@ type Job<'a> = (usize, &'a mut [f64], &'a mut [[V3; 2]], &'a mut [u8], &'a mut [
 /// combinations take the per-contact pass.
 const MAX_BATCH_HISTORY: usize = 16;
 
-/// Bit of `PairList::live`: the pair's share for its second particle was
-/// kept in the deferred slot this pass (cross-block pairs in contact); the
-/// cross pass adds only those.
-const DEFERRED: u8 = 2;
-
 /// Bit of `PairList::live` during a block's walk: the history may have
 /// been non-zero before this pass.
 const WAS_LIVE: u8 = 4;
@@ -356,6 +352,9 @@ struct Block<'a> {
     b: &'a [u32],
     image: &'a [u8],
     images: &'a [V3],
+    /// Deferred slot per pair, and the block's first slot.
+    cslot: &'a [u32],
+    base: usize,
     table: &'a ParamTable,
     dt: f64,
     /// First particle of the block.
@@ -507,8 +506,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 f[j - k.lo] -= fl;
                 tq[j - k.lo] += o.torque_j.lane(l);
             } else {
-                d[pk - k.ps] = [fl, o.torque_j.lane(l)];
-                lv[pk - k.ps] |= DEFERRED;
+                d[k.cslot[pk] as usize - k.base] = [fl, o.torque_j.lane(l)];
             }
         }
     }
@@ -522,8 +520,8 @@ pub struct Forces<'a> {
     pub f: &'a mut [V3],
     /// Torque per particle.
     pub torque: &'a mut [V3],
-    /// Per pair: force on `a` and torque on `b`, for pairs whose `b` lies in
-    /// another block (other slots are unused).
+    /// Per cross pair (`PairList::cslot`): force on `a` and torque on `b`,
+    /// zero when the pair is apart.
     pub defer: &'a mut Vec<[V3; 2]>,
 }
 
@@ -538,11 +536,10 @@ pub fn cross_gather(pairs: &PairList, defer: &[[V3; 2]], f: &mut [V3], torque: &
         for q in 0..fc.len() {
             let i = ci * bs + q;
             let (s, e) = (pairs.cross_start[i] as usize, pairs.cross_start[i + 1] as usize);
-            for &k in &pairs.cross[s..e] {
-                if pairs.live[k as usize] & DEFERRED == 0 {
-                    continue;
-                }
-                let o = &defer[k as usize];
+            // apart pairs add zeros, which leave every bit as it is: the
+            // sums started from +0.0, so they are never -0.0
+            for &slot in &pairs.cross[s..e] {
+                let o = &defer[slot as usize];
                 fc[q] -= o[0];
                 tc[q] += o[1];
             }

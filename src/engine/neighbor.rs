@@ -51,7 +51,7 @@ pub struct PairList {
     /// The distinct periodic shifts the pairs use.
     pub images: Vec<V3>,
     /// Per pair: 1 if its history may be non-zero (bit 0; the force pass
-    /// uses two more bits while it runs). A pair found apart with 0 here is
+    /// uses one more bit while it runs). A pair found apart with 0 here is
     /// skipped without touching its history: most listed pairs are within
     /// the skin but apart, and stay so.
     pub live: Vec<u8>,
@@ -82,10 +82,15 @@ pub struct PairList {
     pub block_start: Vec<u32>,
     /// CSR offsets into `cross` per particle (len = n + 1).
     pub cross_start: Vec<u32>,
-    /// For each particle, the pairs where it is `b` and `a` lies in another
-    /// block, in increasing pair index: their share is added after the
-    /// block pass.
+    /// For each particle, the deferred slots of the pairs where it is `b`
+    /// and `a` lies in another block, in increasing pair index: their share
+    /// is added after the block pass.
     pub cross: Vec<u32>,
+    /// Per pair: its deferred slot if `a` and `b` lie in different blocks
+    /// (slots count those pairs in pair order), else `u32::MAX`.
+    pub cslot: Vec<u32>,
+    /// Slot where each block's cross pairs start (blocks + 1 entries).
+    pub block_cross: Vec<u32>,
 }
 
 /// Particles per block of the force pass. Fixed, never derived from the
@@ -128,6 +133,7 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
     fn chunk(&self, range: std::ops::Range<usize>) -> Chunk {
         let (p, s, w) = (self.p, self.s, self.width);
         let mut out = Chunk { lo: range.start, count: Vec::with_capacity(range.len()), b: vec![], image: vec![], hist: vec![] };
+        let mut buf: Vec<(u32, u8)> = Vec::new();
         let mut found: Vec<(u32, u8)> = Vec::new();
         let mut stencil: Vec<(usize, u8, bool)> = Vec::with_capacity(27);
         let mut stencil_of: Option<[i64; 3]> = None;
@@ -135,16 +141,7 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             let ci = self.grid.cell_of(&p.x[i]);
             if stencil_of != Some(ci) {
                 stencil.clear();
-                for dz in -1i64..=1 {
-                    for dy in -1i64..=1 {
-                        for dx in -1i64..=1 {
-                            if let Some((cell, sh)) = self.grid.neighbor_cell(ci, [dx, dy, dz]) {
-                                let img = (sh[0] + 1) + 3 * (sh[1] + 1) + 9 * (sh[2] + 1);
-                                stencil.push((cell, img as u8, positive(sh)));
-                            }
-                        }
-                    }
-                }
+                self.grid.stencil(ci, &mut stencil);
                 stencil_of = Some(ci);
             }
             let (ti, xi, ri) = (p.tag[i], p.x[i], p.radius[i]);
@@ -152,7 +149,9 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             // when the pair is listed (the id test is a coin toss per
             // candidate, so a branch on it mispredicts half the time)
             let most: usize = stencil.iter().map(|&(cell, _, _)| self.grid.members(cell).len()).sum();
-            found.resize(most, (0, 0));
+            if buf.len() < most {
+                buf.resize(most, (0, 0));
+            }
             let mut len = 0;
             for &(cell, img, pos) in &stencil {
                 let shift = self.images[img as usize];
@@ -165,11 +164,12 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
                     let d = xi - (p.x[ju] + shift);
                     let reach = ri + p.radius[ju] + s.skin + (self.extra_range)(i, ju);
                     let within = d.norm_squared() < reach * reach;
-                    found[len] = (j, img);
+                    buf[len] = (j, img);
                     len += (order & within) as usize;
                 }
             }
-            found.truncate(len);
+            found.clear();
+            found.extend_from_slice(&buf[..len]);
             if !s.exclude_types.is_empty() || !s.exclude_groups.is_empty() {
                 found.retain(|&(j, _)| j as usize == i || !s.excluded(p, i, j as usize));
             }
@@ -370,7 +370,8 @@ impl PairList {
         self.hist = hist;
         self.width = width;
         self.index(n);
-        self.x_built = p.x.clone();
+        self.x_built.clear();
+        self.x_built.extend_from_slice(&p.x);
         self.last_build = step;
         self.builds += 1;
     }
@@ -436,7 +437,8 @@ impl PairList {
             count[i + 1] += count[i];
         }
         let mut fill = count.clone();
-        self.adj = vec![0; 2 * m];
+        self.adj.clear();
+        self.adj.resize(2 * m, 0);
         for k in 0..m {
             let a = self.a[k] as usize;
             let b = self.b[k] as usize;
@@ -455,12 +457,24 @@ impl PairList {
         for q in 0..nblocks {
             self.block_start[q + 1] += self.block_start[q];
         }
+        // cross pairs get consecutive slots in pair order (so each block's
+        // slots are a range), and each particle lists the slots where it is b
+        self.cslot.clear();
+        self.cslot.resize(m, u32::MAX);
+        self.block_cross = vec![0; nblocks + 1];
         let mut ccount = vec![0u32; n + 1];
+        let mut slots = 0u32;
         for k in 0..m {
             let (a, b) = (self.a[k] as usize, self.b[k] as usize);
             if a / bs != b / bs {
                 ccount[b + 1] += 1;
+                self.cslot[k] = slots;
+                slots += 1;
+                self.block_cross[a / bs + 1] = slots;
             }
+        }
+        for q in 0..nblocks {
+            self.block_cross[q + 1] = self.block_cross[q + 1].max(self.block_cross[q]);
         }
         for i in 0..n {
             ccount[i + 1] += ccount[i];
@@ -468,9 +482,9 @@ impl PairList {
         let mut fill = ccount.clone();
         self.cross = vec![0; ccount[n] as usize];
         for k in 0..m {
-            let (a, b) = (self.a[k] as usize, self.b[k] as usize);
-            if a / bs != b / bs {
-                self.cross[fill[b] as usize] = k as u32;
+            let b = self.b[k] as usize;
+            if self.cslot[k] != u32::MAX {
+                self.cross[fill[b] as usize] = self.cslot[k];
                 fill[b] += 1;
             }
         }
@@ -558,6 +572,9 @@ struct Grid {
     periodic: [bool; 3],
     start: Vec<u32>,
     items: Vec<u32>,
+    /// Per axis and bin coordinate: the coordinate and image shift of the
+    /// bins at offsets -1, 0, 1 (coordinate -1: none, a non-periodic edge).
+    axis: [Vec<[(i64, i64); 3]>; 3],
 }
 
 impl Grid {
@@ -598,7 +615,24 @@ impl Grid {
             }
             total = nt;
         }
-        let mut g = Grid { lo, size, dims, periodic, start: vec![], items: vec![] };
+        let axis = std::array::from_fn(|d| {
+            (0..dims[d])
+                .map(|k| {
+                    std::array::from_fn(|o| {
+                        let q = k + o as i64 - 1;
+                        if periodic[d] {
+                            let w = q.rem_euclid(dims[d]);
+                            (w, (q - w) / dims[d])
+                        } else if q < 0 || q >= dims[d] {
+                            (-1, 0)
+                        } else {
+                            (q, 0)
+                        }
+                    })
+                })
+                .collect()
+        });
+        let mut g = Grid { lo, size, dims, periodic, start: vec![], items: vec![], axis };
         let ncell = (dims[0] * dims[1] * dims[2]) as usize;
         let cells: Vec<usize> = p.x.iter().map(|x| g.index(g.cell_of(x))).collect();
         let mut count = vec![0u32; ncell + 1];
@@ -634,26 +668,22 @@ impl Grid {
     fn index(&self, c: [i64; 3]) -> usize {
         ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
     }
-    /// Neighbour cell at offset, with the periodic image shift of its members.
-    fn neighbor_cell(&self, c: [i64; 3], off: [i64; 3]) -> Option<(usize, [i64; 3])> {
-        let mut n = [0i64; 3];
-        let mut sh = [0i64; 3];
-        for d in 0..3 {
-            let k = c[d] + off[d];
-            if self.periodic[d] {
-                let w = k.rem_euclid(self.dims[d]);
-                sh[d] = (k - w) / self.dims[d];
-                n[d] = w;
-            } else {
-                if k < 0 || k >= self.dims[d] {
-                    return None;
+    /// The 27-bin stencil of bin `c` (fewer at non-periodic edges), over
+    /// dz, dy, dx = -1..=1: each bin, the image index of its members' shift
+    /// and whether that shift is lexicographically positive.
+    fn stencil(&self, c: [i64; 3], out: &mut Vec<(usize, u8, bool)>) {
+        let (ax, ay, az) = (&self.axis[0][c[0] as usize], &self.axis[1][c[1] as usize], &self.axis[2][c[2] as usize]);
+        for &(nz, sz) in az {
+            for &(ny, sy) in ay {
+                for &(nx, sx) in ax {
+                    if nx < 0 || ny < 0 || nz < 0 {
+                        continue;
+                    }
+                    let img = (sx + 1) + 3 * (sy + 1) + 9 * (sz + 1);
+                    out.push((self.index([nx, ny, nz]), img as u8, positive([sx, sy, sz])));
                 }
-                n[d] = k;
             }
         }
-        // with fewer than 3 bins, different offsets must not revisit the same
-        // (cell, shift): they cannot, since the shift differs.
-        Some((self.index(n), sh))
     }
     fn members(&self, cell: usize) -> &[u32] {
         &self.items[self.start[cell] as usize..self.start[cell + 1] as usize]
