@@ -26,7 +26,8 @@
 //!
 //! [`Fix::max_surface_overlap`]: super::fix::Fix::max_surface_overlap
 
-use super::neighbor::ADJ_B;
+use super::neighbor::{PairList, ADJ_B};
+use super::particles::Particles;
 use super::sim::{Dialect, Sim};
 use crate::error::Error;
 use crate::physics::V3;
@@ -209,7 +210,7 @@ fn note_setup_overlaps(sim: &mut Sim) {
         if a >= p.len() || b >= p.len() || found.len() >= SETUP_OVERLAP_CAP {
             continue;
         }
-        let f = pair_overlap(sim, k);
+        let f = pair_overlap(p, &sim.pairs, k);
         if f > SETUP_OVERLAP_NOTE {
             let (ta, tb) = (p.tag[a].min(p.tag[b]), p.tag[a].max(p.tag[b]));
             found.push((ta, tb, f));
@@ -222,10 +223,9 @@ fn note_setup_overlaps(sim: &mut Sim) {
 /// Overlap of pair k at the current positions as a fraction of the smaller
 /// radius (the `maxoverlap` measure; negative when apart).
 #[inline]
-fn pair_overlap(sim: &Sim, k: usize) -> f64 {
-    let p = &sim.particles;
-    let (a, b) = (sim.pairs.a[k] as usize, sim.pairs.b[k] as usize);
-    let r = (p.x[a] - p.x[b] - sim.pairs.shift(k)).norm();
+fn pair_overlap(p: &Particles, pairs: &PairList, k: usize) -> f64 {
+    let (a, b) = (pairs.a[k] as usize, pairs.b[k] as usize);
+    let r = (p.x[a] - p.x[b] - pairs.shift(k)).norm();
     (p.radius[a] + p.radius[b] - r) / p.radius[a].min(p.radius[b])
 }
 
@@ -250,13 +250,19 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
     // only when something is flagged)
     let t2dt = travel2.map_or(f64::INFINITY, |t2| t2 / dt2.max(f64::MIN_POSITIVE));
     let s2 = speed2.unwrap_or(f64::INFINITY);
-    let mut flagged = false;
-    for ((x, v), (w, &r)) in p.x.iter().zip(&p.v).zip(p.omega.iter().zip(&p.radius)) {
-        let v2 = v.norm_squared();
-        let sum = x.x + x.y + x.z + v2 + w.x + w.y + w.z;
-        // v2 > (travel R / dt)^2 is |v| dt > travel R
-        flagged |= !sum.is_finite() | (v2 > t2dt * (r * r)) | (v2 > s2);
-    }
+    let flag = |range: std::ops::Range<usize>| {
+        let mut flagged = false;
+        for i in range {
+            let (x, v, w, r) = (&p.x[i], &p.v[i], &p.omega[i], p.radius[i]);
+            let v2 = v.norm_squared();
+            let sum = x.x + x.y + x.z + v2 + w.x + w.y + w.z;
+            // v2 > (travel R / dt)^2 is |v| dt > travel R
+            flagged |= !sum.is_finite() | (v2 > t2dt * (r * r)) | (v2 > s2);
+        }
+        flagged
+    };
+    // a yes/no, in fixed chunks: the same answer on any thread count
+    let flagged = in_chunks(p.len(), flag).into_iter().any(|f| f);
     for i in 0..if flagged { p.len() } else { 0 } {
         let (x, v, w) = (&p.x[i], &p.v[i], &p.omega[i]);
         // one test for the common case; the sum of finite values overflows
@@ -292,24 +298,34 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
     }
     let lim = if overlaps && pairs_valid(sim) { g.overlap } else { None };
     if let Some(lim) = lim {
-        let mut worst: Option<(usize, usize, f64)> = None;
         let n = p.len();
         let pl = &sim.pairs;
-        for (k, (&a, &b)) in pl.a.iter().zip(&pl.b).enumerate() {
-            let shift = pl.shift(k);
-            let (a, b) = (a as usize, b as usize);
-            if a >= n || b >= n {
-                continue;
-            }
-            // compare squared distances; take the root only for violations
-            let (ra, rb) = (p.radius[a], p.radius[b]);
-            let reach = ra + rb - lim * ra.min(rb);
-            let r2 = (p.x[a] - p.x[b] - shift).norm_squared();
-            if reach > 0.0 && r2 < reach * reach {
-                let f = pair_overlap(sim, k);
-                if worst.map_or(true, |(_, _, w)| f > w) {
-                    worst = Some((a, b, f));
+        // the deepest overlap, the first in pair order on a tie: each fixed
+        // chunk keeps its first deepest, and the chunks are compared in order
+        let deepest = |range: std::ops::Range<usize>| {
+            let mut worst: Option<(usize, usize, f64)> = None;
+            for k in range {
+                let (a, b) = (pl.a[k] as usize, pl.b[k] as usize);
+                if a >= n || b >= n {
+                    continue;
                 }
+                // compare squared distances; take the root only for violations
+                let (ra, rb) = (p.radius[a], p.radius[b]);
+                let reach = ra + rb - lim * ra.min(rb);
+                let r2 = (p.x[a] - p.x[b] - pl.shift(k)).norm_squared();
+                if reach > 0.0 && r2 < reach * reach {
+                    let f = pair_overlap(p, pl, k);
+                    if worst.map_or(true, |(_, _, w)| f > w) {
+                        worst = Some((a, b, f));
+                    }
+                }
+            }
+            worst
+        };
+        let mut worst: Option<(usize, usize, f64)> = None;
+        for (a, b, f) in in_chunks(pl.len(), deepest).into_iter().flatten() {
+            if worst.map_or(true, |(_, _, w)| f > w) {
+                worst = Some((a, b, f));
             }
         }
         if let Some((a, b, f)) = worst {
@@ -331,6 +347,20 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
         return Some(Trip::Travel(i, r));
     }
     worst_speed.map(|(i, s)| Trip::Speed(i, s))
+}
+
+/// `job` over 0..n in fixed chunks, in parallel when there are several; the
+/// results in chunk order.
+fn in_chunks<T: Send>(n: usize, job: impl Fn(std::ops::Range<usize>) -> T + Sync) -> Vec<T> {
+    use rayon::prelude::*;
+    const GUARD_CHUNK: usize = 4 * super::integrate::CHUNK;
+    let chunks = n.div_ceil(GUARD_CHUNK);
+    let range = |c: usize| c * GUARD_CHUNK..((c + 1) * GUARD_CHUNK).min(n);
+    if chunks > 1 {
+        (0..chunks).into_par_iter().map(|c| job(range(c))).collect()
+    } else {
+        vec![job(0..n)]
+    }
 }
 
 /// Copy the state into the snapshot buffers (no allocation once they are

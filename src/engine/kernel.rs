@@ -513,8 +513,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
 }
 
 /// Where a force pass adds its forces: `f` and `torque` per particle (which
-/// the caller has cleared or filled with what comes first), and the
-/// deferred shares of cross-block pairs.
+/// the caller has cleared to +0.0: [`cross_gather`] adds zero shares, which
+/// leave a sum that never was -0.0 bit for bit), and the deferred shares of
+/// cross-block pairs.
 pub struct Forces<'a> {
     /// Force per particle.
     pub f: &'a mut [V3],
