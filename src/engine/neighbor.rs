@@ -127,12 +127,22 @@ struct BuildCtx<'a, F> {
     extra_range: &'a F,
     old: &'a Carry,
     width: usize,
+    /// Pairs per particle at the last build (to size the chunks' buffers).
+    per_particle: usize,
 }
 
 impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
     fn chunk(&self, range: std::ops::Range<usize>) -> Chunk {
         let (p, s, w) = (self.p, self.s, self.width);
-        let mut out = Chunk { lo: range.start, count: Vec::with_capacity(range.len()), b: vec![], image: vec![], hist: vec![] };
+        // room for the pairs per particle of the last build, plus a margin
+        let room = range.len() * (self.per_particle + 2);
+        let mut out = Chunk {
+            lo: range.start,
+            count: Vec::with_capacity(range.len()),
+            b: Vec::with_capacity(room),
+            image: Vec::with_capacity(room),
+            hist: Vec::with_capacity(room * w),
+        };
         let mut buf: Vec<(u32, u8)> = Vec::new();
         let mut found: Vec<(u32, u8)> = Vec::new();
         let mut stencil: Vec<(usize, u8, bool)> = Vec::with_capacity(27);
@@ -333,7 +343,8 @@ impl PairList {
             }
             let emax = rep.iter().flat_map(|&(_, i)| rep.iter().map(move |&(_, j)| (i, j))).map(|(i, j)| extra_range(i, j)).fold(0.0, f64::max);
             let grid = Grid::new(p, dom, 2.0 * rmax + s.skin + emax);
-            let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width };
+            let per_particle = self.a.len() / self.x_built.len().max(1);
+            let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width, per_particle };
             let nchunks = n.div_ceil(CHUNK);
             chunks = if nchunks > 1 {
                 (0..nchunks).into_par_iter().map(|c| ctx.chunk(c * CHUNK..((c + 1) * CHUNK).min(n))).collect()
@@ -342,10 +353,18 @@ impl PairList {
             };
         }
         let m: usize = chunks.iter().map(|c| c.b.len()).sum();
-        let mut a = Vec::with_capacity(m);
-        let mut b = Vec::with_capacity(m);
-        let mut image = Vec::with_capacity(m);
-        let mut hist = Vec::with_capacity(m * width);
+        // the list's buffers are reused (the previous b and history too, once
+        // the chunks have read them): no fresh pages on every build
+        let (by_id, (mut b, mut hist)) = match carry {
+            Carry::ByIndex { b, hist, .. } => (None, (b, hist)),
+            Carry::ById(old) => (Some(old), (std::mem::take(&mut self.b), std::mem::take(&mut self.hist))),
+            Carry::None => (None, (std::mem::take(&mut self.b), std::mem::take(&mut self.hist))),
+        };
+        let (a, image) = (&mut self.a, &mut self.image);
+        a.clear();
+        b.clear();
+        image.clear();
+        hist.clear();
         for c in &chunks {
             for (k, &cnt) in c.count.iter().enumerate() {
                 a.extend(std::iter::repeat_n((c.lo + k) as u32, cnt as usize));
@@ -354,7 +373,7 @@ impl PairList {
             image.extend_from_slice(&c.image);
             hist.extend_from_slice(&c.hist);
         }
-        if let Carry::ById(old) = &carry {
+        if let Some(old) = &by_id {
             // storage changed since the last build: match history by id pair
             for k in 0..m {
                 if let Some(h) = old.get(&(p.tag[a[k] as usize], p.tag[b[k] as usize])) {
@@ -362,10 +381,9 @@ impl PairList {
                 }
             }
         }
-        self.keys = a.iter().zip(&b).map(|(&i, &j)| (p.tag[i as usize], p.tag[j as usize])).collect();
-        self.a = a;
+        self.keys.clear();
+        self.keys.extend(a.iter().zip(&b).map(|(&i, &j)| (p.tag[i as usize], p.tag[j as usize])));
         self.b = b;
-        self.image = image;
         self.images = images;
         self.hist = hist;
         self.width = width;

@@ -243,8 +243,11 @@ impl Sim {
         let p = &mut self.particles;
         if p.len() >= 2 * super::integrate::CHUNK {
             use rayon::prelude::*;
-            p.f.par_chunks_mut(super::integrate::CHUNK).for_each(|c| c.fill(V3::zeros()));
-            p.torque.par_chunks_mut(super::integrate::CHUNK).for_each(|c| c.fill(V3::zeros()));
+            // one parallel loop for both: each loop wakes the pool's workers
+            p.f.par_chunks_mut(super::integrate::CHUNK).zip(p.torque.par_chunks_mut(super::integrate::CHUNK)).for_each(|(f, t)| {
+                f.fill(V3::zeros());
+                t.fill(V3::zeros());
+            });
         } else {
             p.f.fill(V3::zeros());
             p.torque.fill(V3::zeros());
