@@ -27,6 +27,7 @@
 //! [`Fix::max_surface_overlap`]: super::fix::Fix::max_surface_overlap
 
 use super::neighbor::{PairList, ADJ_B};
+use super::integrate::in_chunks;
 use super::particles::Particles;
 use super::sim::{Dialect, Sim};
 use crate::error::Error;
@@ -262,7 +263,7 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
         flagged
     };
     // a yes/no, in fixed chunks: the same answer on any thread count
-    let flagged = in_chunks(p.len(), flag).into_iter().any(|f| f);
+    let flagged = in_chunks(p.len(), GUARD_CHUNK, flag).into_iter().any(|f| f);
     for i in 0..if flagged { p.len() } else { 0 } {
         let (x, v, w) = (&p.x[i], &p.v[i], &p.omega[i]);
         // one test for the common case; the sum of finite values overflows
@@ -323,7 +324,7 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
             worst
         };
         let mut worst: Option<(usize, usize, f64)> = None;
-        for (a, b, f) in in_chunks(pl.len(), deepest).into_iter().flatten() {
+        for (a, b, f) in in_chunks(pl.len(), GUARD_CHUNK, deepest).into_iter().flatten() {
             if worst.map_or(true, |(_, _, w)| f > w) {
                 worst = Some((a, b, f));
             }
@@ -349,19 +350,8 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
     worst_speed.map(|(i, s)| Trip::Speed(i, s))
 }
 
-/// `job` over 0..n in fixed chunks, in parallel when there are several; the
-/// results in chunk order.
-fn in_chunks<T: Send>(n: usize, job: impl Fn(std::ops::Range<usize>) -> T + Sync) -> Vec<T> {
-    use rayon::prelude::*;
-    const GUARD_CHUNK: usize = 4 * super::integrate::CHUNK;
-    let chunks = n.div_ceil(GUARD_CHUNK);
-    let range = |c: usize| c * GUARD_CHUNK..((c + 1) * GUARD_CHUNK).min(n);
-    if chunks > 1 {
-        (0..chunks).into_par_iter().map(|c| job(range(c))).collect()
-    } else {
-        vec![job(0..n)]
-    }
-}
+/// Items per chunk of the guard's parallel scans.
+const GUARD_CHUNK: usize = 4 * super::integrate::CHUNK;
 
 /// Copy the state into the snapshot buffers (no allocation once they are
 /// large enough).

@@ -13,6 +13,19 @@ pub const INERTIA: f64 = 0.4;
 /// two chunks the loop runs inline (rayon's fork costs more than it saves).
 pub const CHUNK: usize = 4096;
 
+/// `job` over `0..n` in fixed chunks of `chunk`, in parallel when there are
+/// several; the results in chunk order. The chunks never depend on the
+/// thread count, so neither does anything combined from them in order.
+pub fn in_chunks<T: Send>(n: usize, chunk: usize, job: impl Fn(std::ops::Range<usize>) -> T + Sync) -> Vec<T> {
+    let chunks = n.div_ceil(chunk);
+    let range = |c: usize| c * chunk..((c + 1) * chunk).min(n);
+    if chunks > 1 {
+        (0..chunks).into_par_iter().map(|c| job(range(c))).collect()
+    } else {
+        vec![job(0..n)]
+    }
+}
+
 /// What one half-step changes of particle `i`: position, velocity, angular
 /// velocity, given its force, torque, mass and radius.
 struct Half<'a> {

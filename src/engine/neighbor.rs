@@ -9,7 +9,7 @@
 //! index, so forces can be gathered in a fixed order on any thread count.
 
 use super::domain::Domain;
-use super::integrate::CHUNK;
+use super::integrate::{in_chunks, CHUNK};
 use super::particles::Particles;
 use crate::physics::V3;
 use std::collections::HashMap;
@@ -323,7 +323,6 @@ impl PairList {
     where
         F: Fn(usize, usize) -> f64 + Sync,
     {
-        use rayon::prelude::*;
         let n = p.len();
         let lens = dom.lengths();
         // the 27 images a cell stencil reaches, indexed by the cell shift
@@ -345,12 +344,7 @@ impl PairList {
             let grid = Grid::new(p, dom, 2.0 * rmax + s.skin + emax);
             let per_particle = self.a.len() / self.x_built.len().max(1);
             let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width, per_particle };
-            let nchunks = n.div_ceil(CHUNK);
-            chunks = if nchunks > 1 {
-                (0..nchunks).into_par_iter().map(|c| ctx.chunk(c * CHUNK..((c + 1) * CHUNK).min(n))).collect()
-            } else {
-                vec![ctx.chunk(0..n)]
-            };
+            chunks = in_chunks(n, CHUNK, |r| ctx.chunk(r));
         }
         let m: usize = chunks.iter().map(|c| c.b.len()).sum();
         // the list's buffers are reused (the previous b and history too, once
@@ -488,11 +482,11 @@ impl PairList {
                 ccount[b + 1] += 1;
                 self.cslot[k] = slots;
                 slots += 1;
-                self.block_cross[a / bs + 1] = slots;
+                self.block_cross[a / bs + 1] += 1;
             }
         }
         for q in 0..nblocks {
-            self.block_cross[q + 1] = self.block_cross[q + 1].max(self.block_cross[q]);
+            self.block_cross[q + 1] += self.block_cross[q];
         }
         for i in 0..n {
             ccount[i + 1] += ccount[i];
