@@ -84,20 +84,44 @@ pub trait ContactKernel: Send + Sync {
 impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C, R> {
     const WIDTH: usize = N::HISTORY + C::HISTORY + T::HISTORY + R::HISTORY;
     /// Whether the pair pass runs the laws on batches of [`LANES`] contacts:
-    /// every law has a lane form and acts only on touching pairs.
-    const BATCHED: bool = N::LANES && T::LANES && C::LANES && R::LANES && N::CONTACT_ONLY && !C::NONCONTACT && Self::WIDTH <= MAX_BATCH_HISTORY;
+    /// every law has a lane form and the normal law acts only on touching
+    /// pairs (cohesion may reach beyond).
+    const BATCHED: bool = N::LANES && T::LANES && C::LANES && R::LANES && N::CONTACT_ONLY && Self::WIDTH <= MAX_BATCH_HISTORY;
 
-    /// The laws on a batch of touching contacts, in the fixed order.
+    /// The laws on a batch of contacts, in the fixed order: lanes that touch
+    /// as [`Laws::apply`] does when `delta > 0`; with non-contact cohesion,
+    /// lanes within its reach but apart as `apply` does otherwise (cohesion
+    /// alone, the other laws' history cleared). Both are computed and each
+    /// lane keeps its own, so an apart lane's normal law may compute NaN
+    /// (the square root of a negative overlap) that no output keeps.
     #[inline(always)]
     fn apply_lanes<L: Real, P: Coeffs<L>>(&self, c: &ContactL<L>, pp: &P, hist: &mut [L]) -> OutL<L> {
         let mut out = OutL::zeros();
         let (hn, rest) = hist.split_at_mut(N::HISTORY);
         let (hc, rest) = rest.split_at_mut(C::HISTORY);
         let (ht, hr) = rest.split_at_mut(T::HISTORY);
+        // cohesion alone, from the same history, for the lanes apart
+        let zero = L::splat(0.0);
+        let mut hc_apart = [zero; MAX_BATCH_HISTORY];
+        let mut apart = OutL::zeros();
+        if C::NONCONTACT {
+            hc_apart[..C::HISTORY].copy_from_slice(hc);
+            self.cohesion.cohesion_lanes(c, pp, &mut hc_apart[..C::HISTORY], &mut apart);
+        }
         self.normal.normal_lanes(c, pp, hn, &mut out);
         self.cohesion.cohesion_lanes(c, pp, hc, &mut out);
         self.tangential.tangential_lanes(c, pp, ht, &mut out);
         self.rolling.rolling_lanes(c, pp, hr, &mut out);
+        if C::NONCONTACT {
+            let on = c.delta.gt(zero);
+            for h in hn.iter_mut().chain(ht.iter_mut()).chain(hr.iter_mut()) {
+                *h = L::select(on, *h, zero);
+            }
+            for (h, a) in hc.iter_mut().zip(&hc_apart) {
+                *h = L::select(on, *h, *a);
+            }
+            out = OutL::select(on, &out, &apart);
+        }
         out
     }
 
@@ -395,11 +419,20 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let mut queue = [0usize; LANES];
         let mut queued = 0;
         let mut virial = 0.0;
+        // non-contact cohesion reaches beyond touching, by the pair's
+        // `extra_range` (as in the per-contact pass)
+        let one_type = k.table.ntypes == 1;
+        let extra0 = if C::NONCONTACT { k.table.get(1, 1).extra_range } else { 0.0 };
         let pairs = k.a[k.ps..k.pe].iter().zip(&k.b[k.ps..k.pe]).zip(&k.image[k.ps..k.pe]);
         for (q, ((&i, &j), &img)) in pairs.enumerate() {
             let (i, j) = (i as usize, j as usize);
             let xj = p.x[j] + k.images[img as usize];
-            let reach = p.radius[i] + p.radius[j];
+            let reach = if C::NONCONTACT {
+                let extra = if one_type { extra0 } else { k.table.get(p.kind[i], p.kind[j]).extra_range };
+                p.radius[i] + p.radius[j] + extra
+            } else {
+                p.radius[i] + p.radius[j]
+            };
             let r2 = (p.x[i] - xj).norm_squared();
             // no branch on touching, which is a coin toss for pairs in the
             // skin: every pair is written to the queue, touching ones stay
@@ -489,8 +522,10 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             let pk = queue[l];
             let (i, j) = (k.a[pk] as usize, k.b[pk] as usize);
             let hk = &mut h[(pk - k.ps) * w..(pk - k.ps + 1) * w];
-            if c.delta.0[l] <= 0.0 {
-                // touching by r^2 but not by the overlap (rounding): apart
+            let delta = c.delta.0[l];
+            let beyond = if C::NONCONTACT { delta <= -coeffs.p[l].extra_range } else { delta <= 0.0 };
+            if beyond {
+                // within reach by r^2 but not by the overlap (rounding): apart
                 hk.fill(0.0);
                 lv[pk - k.ps] = 0;
                 continue;
@@ -774,5 +809,38 @@ mod tests {
             q.tangential_damping = 1.0;
         });
         assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
+        // the paper's model: viscoelastic Hertz (A_n computed at first
+        // touch), Cundall-Strack on the total, EPSD rolling, and van der
+        // Waals reaching across gaps up to D_max (a reach per type pair)
+        use crate::physics::cohesion::vdw::Hamaker;
+        use crate::physics::normal::viscoelastic::PaperViscoelastic;
+        use crate::physics::rolling::paper::PaperEpsd;
+        use crate::physics::tangential::paper::PaperCundallStrack;
+        let laws = Laws { normal: PaperViscoelastic, tangential: PaperCundallStrack, cohesion: Hamaker, rolling: PaperEpsd { torsion_torque: false } };
+        assert!(Laws::<PaperViscoelastic, PaperCundallStrack, Hamaker, PaperEpsd>::BATCHED);
+        let table = two_type_table(|q, s| {
+            q.y_eff = 1e4 * s as f64;
+            q.g_eff = 4e3 * s as f64;
+            q.beta = if s == 4 { 0.0 } else { 0.3 };
+            q.mu = if s == 3 { 0.05 } else { 0.5 };
+            q.mu_r = 0.1;
+            q.hamaker = 1e-2;
+            q.d_min = 1e-2;
+            q.d_max = 0.01 * s as f64;
+            q.extra_range = q.d_max;
+        });
+        let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
+        assert_eq!(batched, scalar);
+        // pairs within D_max but apart exist in the bed, so the lanes' apart
+        // branch is exercised
+        let (p, _) = random_bed(11);
+        let gaps = (0..p.len())
+            .flat_map(|i| (0..i).map(move |j| (i, j)))
+            .filter(|&(i, j)| {
+                let gap = (p.x[i] - p.x[j]).norm() - p.radius[i] - p.radius[j];
+                gap > 0.0 && gap < 0.02
+            })
+            .count();
+        assert!(gaps > 50, "only {gaps} pairs in the van der Waals gap");
     }
 }

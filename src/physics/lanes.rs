@@ -20,6 +20,8 @@ pub const LANES: usize = 8;
 pub trait Mask: Copy {
     /// Both.
     fn and(self, o: Self) -> Self;
+    /// Whether any lane is set.
+    fn any(self) -> bool;
 }
 
 /// A float or a batch of floats.
@@ -52,6 +54,8 @@ pub trait Real:
     fn lt(self, o: Self) -> Self::Mask;
     /// `self != o`.
     fn ne(self, o: Self) -> Self::Mask;
+    /// `self == o`.
+    fn equal(self, o: Self) -> Self::Mask;
     /// Lanes that are infinite.
     fn is_inf(self) -> Self::Mask;
     /// `a` where `m`, else `b`.
@@ -64,6 +68,10 @@ impl Mask for bool {
     #[inline(always)]
     fn and(self, o: bool) -> bool {
         self & o
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
     }
 }
 
@@ -92,6 +100,10 @@ impl Real for f64 {
     #[inline(always)]
     fn ne(self, o: f64) -> bool {
         self != o
+    }
+    #[inline(always)]
+    fn equal(self, o: f64) -> bool {
+        self == o
     }
     #[inline(always)]
     fn is_inf(self) -> bool {
@@ -146,6 +158,10 @@ impl Mask for M8 {
             r[l] &= o.0[l];
         }
         M8(r)
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.0.iter().fold(false, |a, &b| a | b)
     }
 }
 
@@ -236,6 +252,10 @@ impl Real for F8 {
     #[inline(always)]
     fn ne(self, o: F8) -> M8 {
         cmp(self.0, o.0, |a, b| a != b)
+    }
+    #[inline(always)]
+    fn equal(self, o: F8) -> M8 {
+        cmp(self.0, o.0, |a, b| a == b)
     }
     #[inline(always)]
     fn is_inf(self) -> M8 {

@@ -13,6 +13,7 @@
 use super::normal::granular::{GranularDamping, GranularNormal};
 use super::tangential::granular::GranularTangential;
 use super::PairParams;
+use super::lanes::{Mask, Real};
 use crate::error::{Error, Result};
 use crate::script::source::Span;
 
@@ -454,12 +455,13 @@ pub fn mp_beta(e: f64, v_ref: f64, exact: bool) -> Option<f64> {
 
 /// Dissipative constant A_n = 2 beta / (3 (k_n/m*)^{2/5}) of the paper's
 /// Eq. 10 for a pair with k_n (N/m^{3/2}) and m* (0 for infinite m*).
+/// On lanes: each lane its own pair.
 #[inline(always)]
-pub fn viscoelastic_a_n(beta: f64, k_n: f64, m_eff: f64) -> f64 {
-    if !(m_eff > 0.0 && m_eff.is_finite() && k_n > 0.0) {
-        return 0.0;
-    }
-    2.0 * beta / (3.0 * (k_n / m_eff).powf(0.4))
+pub fn viscoelastic_a_n<R: Real>(beta: R, k_n: R, m_eff: R) -> R {
+    let zero = R::splat(0.0);
+    let valid = m_eff.gt(zero).and(k_n.gt(zero));
+    let a_n = beta * 2.0 / ((k_n / m_eff).powf(0.4) * 3.0);
+    R::select(m_eff.is_inf(), zero, R::select(valid, a_n, zero))
 }
 
 /// Hamaker constant from the surface energy, A_H = 24 pi D_min^2 gamma (paper Eq. 14).

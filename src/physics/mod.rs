@@ -401,6 +401,26 @@ impl<R: Real> OutL<R> {
         let v = Vec3::zeros();
         OutL { fn_elastic: z, fn_damp: z, fn_coh: z, fn_for_friction: z, kn: z, kt: z, a: z, gamma_n: z, gamma_t: z, ft: v, torque_i: v, torque_j: v }
     }
+    /// `a` where `m`, else `b`, per lane and field.
+    #[inline(always)]
+    pub fn select(m: R::Mask, a: &Self, b: &Self) -> Self {
+        let s = |x: R, y: R| R::select(m, x, y);
+        let v = |x: Vec3<R>, y: Vec3<R>| Vec3::select(m, x, y);
+        OutL {
+            fn_elastic: s(a.fn_elastic, b.fn_elastic),
+            fn_damp: s(a.fn_damp, b.fn_damp),
+            fn_coh: s(a.fn_coh, b.fn_coh),
+            fn_for_friction: s(a.fn_for_friction, b.fn_for_friction),
+            kn: s(a.kn, b.kn),
+            kt: s(a.kt, b.kt),
+            a: s(a.a, b.a),
+            gamma_n: s(a.gamma_n, b.gamma_n),
+            gamma_t: s(a.gamma_t, b.gamma_t),
+            ft: v(a.ft, b.ft),
+            torque_i: v(a.torque_i, b.torque_i),
+            torque_j: v(a.torque_j, b.torque_j),
+        }
+    }
     /// Total normal force along n.
     #[inline(always)]
     pub fn fn_total(&self) -> R {

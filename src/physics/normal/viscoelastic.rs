@@ -21,8 +21,9 @@
 //! current stiffness k_t sqrt(delta) (`out.kt`) and the tangential damping
 //! A_t sqrt(delta) with A_t = 3/2 A_n k_n (`out.gamma_t`, Eq. 11).
 
+use crate::physics::lanes::{Coeffs, Mask, Real};
 use crate::physics::mixing::viscoelastic_a_n;
-use crate::physics::{Contact, ContactOut, NormalLaw, PairParams};
+use crate::physics::{on_one, Contact, ContactL, ContactOut, NormalLaw, OutL, PairParams};
 
 /// The paper's Hertz + Brilliantov normal law. Reads `y_eff`, `g_eff` and
 /// `beta` (Müller-Pöschel beta from the reference restitution). History: the
@@ -32,21 +33,30 @@ pub struct PaperViscoelastic;
 
 impl NormalLaw for PaperViscoelastic {
     const HISTORY: usize = 1;
+    const LANES: bool = true;
     #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
+        on_one(c, out, |c, o| self.normal_lanes(c, p, hist, o));
+    }
+    #[inline(always)]
+    fn normal_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, hist: &mut [R], out: &mut OutL<R>) {
         let sqrt_r = c.r_eff.sqrt();
         // Eq. 12
-        let k_n = 4.0 / 3.0 * p.y_eff * sqrt_r;
-        let k_t = 8.0 * p.g_eff * sqrt_r;
-        let mut a_n = hist[0];
-        if a_n == 0.0 && p.beta != 0.0 {
-            a_n = viscoelastic_a_n(p.beta, k_n, c.m_eff);
-            hist[0] = a_n;
+        let k_n = p.get(|q| q.y_eff) * (4.0 / 3.0) * sqrt_r;
+        let k_t = p.get(|q| q.g_eff) * 8.0 * sqrt_r;
+        // A_n at first touch (a new contact's history is zero); the power is
+        // costly, so a batch without a new contact skips it
+        let zero = R::splat(0.0);
+        let beta = p.get(|q| q.beta);
+        let fresh = hist[0].equal(zero).and(beta.ne(zero));
+        if fresh.any() {
+            hist[0] = R::select(fresh, viscoelastic_a_n(beta, k_n, c.m_eff), hist[0]);
         }
+        let a_n = hist[0];
         let sqrt_delta = c.delta.sqrt();
         // Eq. 10 with d(delta)/dt = -vn; the max(0, .) becomes the damping clamp
-        let gamma_n = 1.5 * a_n * k_n * sqrt_delta;
-        super::store_normal(out, k_n * c.delta * sqrt_delta, -gamma_n * c.vn, 1.0);
+        let gamma_n = a_n * 1.5 * k_n * sqrt_delta;
+        super::store_normal_lanes(out, k_n * c.delta * sqrt_delta, -gamma_n * c.vn, R::splat(1.0));
         out.kn = k_n * sqrt_delta;
         out.kt = k_t * sqrt_delta;
         out.a = (c.r_eff * c.delta).sqrt();

@@ -12,8 +12,9 @@
 //! radius) use R* = R_i and w = w_i. The stored torque is not rotated with
 //! the contact frame.
 
-use super::epsd_torque;
-use crate::physics::{Contact, ContactOut, PairParams, RollingLaw};
+use super::epsd_torque_lanes;
+use crate::physics::lanes::{Coeffs, Real};
+use crate::physics::{on_one, Contact, ContactL, ContactOut, OutL, PairParams, RollingLaw};
 
 /// The paper's rolling resistance. Reads `mu_r`; `out.kt`,
 /// `out.fn_for_friction`. History: the spring torque (3).
@@ -25,11 +26,16 @@ pub struct PaperEpsd {
 
 impl RollingLaw for PaperEpsd {
     const HISTORY: usize = 3;
+    const LANES: bool = true;
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
-        let w = if c.is_wall() { c.wi } else { c.wi - c.wj };
+        on_one(c, out, |c, o| self.rolling_lanes(c, p, hist, o));
+    }
+    #[inline(always)]
+    fn rolling_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, hist: &mut [R], out: &mut OutL<R>) {
+        let w = if c.wall { c.wi } else { c.wi - c.wj };
         let r = c.r_eff;
         let k_r = out.kt * r * r;
-        epsd_torque(c, p, hist, out, k_r, 0.0, self.torsion_torque, r, w);
+        epsd_torque_lanes(c, p, hist, out, k_r, R::splat(0.0), self.torsion_torque, r, w);
     }
 }

@@ -15,8 +15,9 @@
 //! LIGGGHTS contact-point distance R - delta/2 (the paper writes the torque
 //! lever as d/2 - delta; the difference is delta/2 << d).
 
-use super::{add_tangential_torque, get3, liggghts_levers, put3, rel_tangential_velocity};
-use crate::physics::{Contact, ContactOut, PairParams, TangentialLaw, V3};
+use super::{add_tangential_torque_lanes, get3_lanes, liggghts_levers_lanes, put3_lanes, rel_tangential_velocity_lanes};
+use crate::physics::lanes::{Coeffs, Real, Vec3};
+use crate::physics::{on_one, Contact, ContactL, ContactOut, OutL, PairParams, TangentialLaw};
 
 /// The paper's Cundall-Strack friction. Reads `mu`; `out.kt`, `out.gamma_t`,
 /// `out.fn_for_friction`. History: the spring force (3, N).
@@ -25,25 +26,28 @@ pub struct PaperCundallStrack;
 
 impl TangentialLaw for PaperCundallStrack {
     const HISTORY: usize = 3;
+    const LANES: bool = true;
     #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
-        let (cri, crj) = liggghts_levers(c);
-        let v_t = rel_tangential_velocity(c, cri, crj);
-        let mut spring = get3(hist);
+        on_one(c, out, |c, o| self.tangential_lanes(c, p, hist, o));
+    }
+    #[inline(always)]
+    fn tangential_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, hist: &mut [R], out: &mut OutL<R>) {
+        let (cri, crj) = liggghts_levers_lanes(c);
+        let v_t = rel_tangential_velocity_lanes(c, cri, crj);
+        let mut spring = get3_lanes(hist);
         spring -= c.n * spring.dot(&c.n);
         spring += v_t * (out.kt * c.dt);
-        let total: V3 = spring + v_t * out.gamma_t;
-        let cap = p.mu * out.fn_for_friction.abs();
+        let total = spring + v_t * out.gamma_t;
+        let cap = p.get(|q| q.mu) * out.fn_for_friction.abs();
         let mag = total.norm();
-        let ft = if mag > cap {
-            let capped = total * (cap / mag);
-            spring = capped;
-            -capped
-        } else {
-            -total
-        };
-        put3(hist, &spring);
+        // slip: the total scaled onto the cap, and the spring set to it
+        let slip = mag.gt(cap);
+        let capped = total * (cap / mag);
+        spring = Vec3::select(slip, capped, spring);
+        let ft = -Vec3::select(slip, capped, total);
+        put3_lanes(hist, &spring);
         out.ft = ft;
-        add_tangential_torque(c, &ft, cri, crj, out);
+        add_tangential_torque_lanes(c, &ft, cri, crj, out);
     }
 }
