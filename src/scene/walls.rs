@@ -40,6 +40,19 @@ pub struct WallGran {
     cyl_radius: Option<f64>,
     /// JKR normal law: contacts last beyond touching.
     jkr: bool,
+    /// Particles within reach + skin of the wall at pair-list build
+    /// `candidates_at`, in increasing index (see `post_force`).
+    candidates: Vec<u32>,
+    candidates_at: Option<u64>,
+}
+
+/// Zero a history that is not already zero (bit for bit), so that the many
+/// particles away from the wall only read theirs.
+#[inline(always)]
+fn clear(hist: &mut [f64]) {
+    if hist.iter().any(|h| h.to_bits() != 0) {
+        hist.fill(0.0);
+    }
 }
 
 impl Fix for WallGran {
@@ -61,6 +74,18 @@ impl Fix for WallGran {
         let shift = self.motion.shift(axis, t);
         let vwall = self.motion.velocity(t);
         let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
+        // Between pair-list builds no particle moves more than half the skin
+        // when every step checks for a build (delay 0, every 1, check yes):
+        // then a static wall needs only the particles within reach + skin of
+        // it at the last build, and the others have no contact and zero
+        // history. Otherwise (moving wall, delayed checks) every particle is
+        // tried every step.
+        let ns = &sim.neigh;
+        let bounded = matches!(self.motion, WallMotion::None) && ns.check && ns.delay == 0 && ns.every <= 1;
+        let build = sim.pairs.builds;
+        let built = bounded && sim.pairs.x_built.len() == sim.particles.len();
+        let reuse = built && self.candidates_at == Some(build);
+        let margin = if built { Some(sim.neigh.skin) } else { None };
         let this = &*self;
         let (group, width, w) = (this.group, this.width, this.width.max(1));
         let crate::engine::particles::Particles {
@@ -76,83 +101,115 @@ impl Fix for WallGran {
             extra,
             ..
         } = &mut sim.particles;
-        let (x, v, omega, radius, mass, kind, mask) =
-            (&*x, &*v, &*omega, &*radius, &*mass, &*kind, &*mask);
+        let (x, v, omega, radius, mass, kind, mask) = (&*x, &*v, &*omega, &*radius, &*mass, &*kind, &*mask);
         let data = &mut extra[col].data;
-        // particles in fixed chunks, in parallel from two chunks up: each
-        // particle touches only its own force, torque and history, so the
-        // bits do not depend on the thread count
-        let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| {
+        // the wall's contact with particle i, added to its force and torque;
+        // with `margin`, whether i is within reach + margin of the wall
+        let one = |i: usize, fi: &mut V3, ti: &mut V3, hist: &mut [f64], margin: Option<f64>| -> bool {
+            if mask[i] & group == 0 {
+                return false;
+            }
+            let ri = radius[i];
+            let pp = this.table.get(kind[i], this.wall_type);
+            // a JKR contact lives on to the pull-off overlap (< 0): look that
+            // far; LAMMPS's zcylinder finds no contact once the sphere is
+            // off the wall (its `delr > radius` test)
+            let reach = if this.jkr && this.cyl_radius.is_none() { -jkr_pulloff_overlap(ri, pp.y_eff, pp.cohesion) } else { 0.0 };
+            let near = margin.is_some_and(|m| this.wall.contact(x[i], ri + reach + m, shift).is_some());
+            let Some((delta, n, _pt)) = this.wall.contact(x[i], ri + reach, shift) else {
+                clear(hist);
+                return near;
+            };
+            let delta = delta - reach;
+            if delta <= 0.0 && !this.jkr {
+                clear(hist);
+                return near;
+            }
+            // LAMMPS zcylinder: the wall's curvature enters R* through
+            // rwall = -2 R_c (met from inside) or +2 R_c (outside)
+            let r_eff = match this.cyl_radius {
+                Some(rc) => {
+                    let rho = (x[i].x * x[i].x + x[i].y * x[i].y).sqrt();
+                    let rwall = if rho < rc { -2.0 * rc } else { 2.0 * rc };
+                    ri * rwall / (ri + rwall)
+                }
+                None => ri,
+            };
+            let mi = mass[i];
+            let vr = v[i] - vwall;
+            let c = Contact {
+                n,
+                r: ri - delta,
+                delta,
+                ri,
+                rj: f64::INFINITY,
+                r_eff,
+                mi,
+                mj: f64::INFINITY,
+                m_eff: mi,
+                vr,
+                vn: vr.dot(&n),
+                wi: omega[i],
+                wj: V3::zeros(),
+                dt,
+            };
+            let out = this.kernel.contact(&c, pp, &mut hist[..width]);
+            *fi += out.force_i(&c);
+            *ti += out.torque_i;
+            true
+        };
+        if reuse {
+            // the candidates in fixed chunks, each with the slices of the
+            // particles from its first candidate to the next chunk's
+            let cands = &this.candidates;
+            let n = f.len();
+            let cuts: Vec<usize> = (0..cands.len().div_ceil(CHUNK)).map(|c| cands[c * CHUNK] as usize).chain([n]).collect();
+            let mut jobs = Vec::with_capacity(cuts.len());
+            let (mut fr, mut tr, mut hr) = (&mut f[cuts[0]..], &mut torque[cuts[0]..], &mut data[cuts[0] * w..]);
+            for (c, win) in cuts.windows(2).enumerate() {
+                let len = win[1] - win[0];
+                let (fc, fnext) = std::mem::take(&mut fr).split_at_mut(len);
+                let (tc, tnext) = std::mem::take(&mut tr).split_at_mut(len);
+                let (hc, hnext) = std::mem::take(&mut hr).split_at_mut(len * w);
+                (fr, tr, hr) = (fnext, tnext, hnext);
+                jobs.push((&cands[c * CHUNK..((c + 1) * CHUNK).min(cands.len())], win[0], fc, tc, hc));
+            }
+            let run = |(cs, lo, fc, tc, hc): (&[u32], usize, &mut [V3], &mut [V3], &mut [f64])| {
+                for &i in cs {
+                    let q = i as usize - lo;
+                    one(i as usize, &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], None);
+                }
+            };
+            if jobs.len() > 1 {
+                jobs.into_par_iter().for_each(run);
+            } else {
+                jobs.into_iter().for_each(run);
+            }
+            return Ok(());
+        }
+        // every particle, in fixed chunks, in parallel from two chunks up:
+        // each particle touches only its own force, torque and history, so
+        // the bits do not depend on the thread count
+        let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Vec<u32> {
+            let mut near = vec![];
             for q in 0..fc.len() {
                 let i = c * CHUNK + q;
-                if mask[i] & group == 0 {
-                    continue;
+                if one(i, &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], margin) {
+                    near.push(i as u32);
                 }
-                let hist = &mut hc[q * w..q * w + width];
-                let ri = radius[i];
-                let pp = this.table.get(kind[i], this.wall_type);
-                // a JKR contact lives on to the pull-off overlap (< 0): look that
-                // far; LAMMPS's zcylinder finds no contact once the sphere is
-                // off the wall (its `delr > radius` test)
-                let reach = if this.jkr && this.cyl_radius.is_none() {
-                    -jkr_pulloff_overlap(ri, pp.y_eff, pp.cohesion)
-                } else {
-                    0.0
-                };
-                let Some((delta, n, _pt)) = this.wall.contact(x[i], ri + reach, shift) else {
-                    hist.fill(0.0);
-                    continue;
-                };
-                let delta = delta - reach;
-                if delta <= 0.0 && !this.jkr {
-                    hist.fill(0.0);
-                    continue;
-                }
-                // LAMMPS zcylinder: the wall's curvature enters R* through
-                // rwall = -2 R_c (met from inside) or +2 R_c (outside)
-                let r_eff = match this.cyl_radius {
-                    Some(rc) => {
-                        let rho = (x[i].x * x[i].x + x[i].y * x[i].y).sqrt();
-                        let rwall = if rho < rc { -2.0 * rc } else { 2.0 * rc };
-                        ri * rwall / (ri + rwall)
-                    }
-                    None => ri,
-                };
-                let mi = mass[i];
-                let vr = v[i] - vwall;
-                let c = Contact {
-                    n,
-                    r: ri - delta,
-                    delta,
-                    ri,
-                    rj: f64::INFINITY,
-                    r_eff,
-                    mi,
-                    mj: f64::INFINITY,
-                    m_eff: mi,
-                    vr,
-                    vn: vr.dot(&n),
-                    wi: omega[i],
-                    wj: V3::zeros(),
-                    dt,
-                };
-                let out = this.kernel.contact(&c, pp, hist);
-                fc[q] += out.force_i(&c);
-                tc[q] += out.torque_i;
             }
+            near
         };
-        if f.len() >= 2 * CHUNK {
-            f.par_chunks_mut(CHUNK)
-                .zip(torque.par_chunks_mut(CHUNK))
-                .zip(data.par_chunks_mut(CHUNK * w))
-                .enumerate()
-                .for_each(body);
+        let near: Vec<Vec<u32>> = if f.len() >= 2 * CHUNK {
+            f.par_chunks_mut(CHUNK).zip(torque.par_chunks_mut(CHUNK)).zip(data.par_chunks_mut(CHUNK * w)).enumerate().map(body).collect()
         } else {
-            f.chunks_mut(CHUNK)
-                .zip(torque.chunks_mut(CHUNK))
-                .zip(data.chunks_mut(CHUNK * w))
-                .enumerate()
-                .for_each(body);
+            f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * w)).enumerate().map(body).collect()
+        };
+        if built {
+            self.candidates = near.concat();
+            self.candidates_at = Some(build);
+        } else {
+            self.candidates_at = None;
         }
         Ok(())
     }
@@ -322,6 +379,8 @@ fn add_wall(s: &mut Session, id: &str, group: u32, spec: PairSpec, table: ParamT
         summary,
         t0,
         in_setup: false,
+        candidates: vec![],
+        candidates_at: None,
     }))
 }
 
