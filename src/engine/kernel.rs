@@ -73,7 +73,9 @@ pub trait ContactKernel: Send + Sync {
     /// Whether pairs that do not touch interact (non-contact cohesion).
     fn noncontact(&self) -> bool;
     /// Force pass over the pair list, block by block (see [`Forces`]):
-    /// adds the pairs' forces and torques and updates their history; returns
+    /// sets each particle's force and torque to its pairs' sum (each block
+    /// clears its particles' first, while they are in cache) and updates the
+    /// pairs' history; returns
     /// the pair virial, the sum of r_ij . F_ij. Follow with [`cross_gather`].
     fn force_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, force: Forces<'_>) -> f64;
     /// One contact with a wall or any other partner given as a `Contact`;
@@ -293,6 +295,9 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             (hrest, drest, frest, trest) = (hr, dr, fr, tr);
             jobs.push((q, h, d, lv, f, tq));
         }
+        // particles beyond the blocks (none while the list is indexed for n)
+        frest.fill(V3::zeros());
+        trest.fill(V3::zeros());
         let beyond = C::NONCONTACT || !N::CONTACT_ONLY;
         // one block: its pairs in increasing index; both shares of a pair
         // inside the block are added at once, the share of a particle of
@@ -302,6 +307,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             let ps = block_start[q] as usize;
             let base = block_cross[q] as usize;
             d.fill([V3::zeros(); 2]);
+            f.fill(V3::zeros());
+            tq.fill(V3::zeros());
             let mut virial = 0.0;
             for k in ps..block_start[q + 1] as usize {
                 let i = a[k] as usize;
@@ -344,6 +351,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         let batched = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
             d.fill([V3::zeros(); 2]);
+            f.fill(V3::zeros());
+            tq.fill(V3::zeros());
             let blk = Block { p, a, b, image, images, cslot, base: block_cross[q] as usize, table, dt, lo: q * bs, ps, pe };
             self.block_batched(&blk, h, d, lv, f, tq)
         };
@@ -547,10 +556,10 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     }
 }
 
-/// Where a force pass adds its forces: `f` and `torque` per particle (which
-/// the caller has cleared to +0.0: [`cross_gather`] adds zero shares, which
-/// leave a sum that never was -0.0 bit for bit), and the deferred shares of
-/// cross-block pairs.
+/// Where a force pass puts its forces: `f` and `torque` per particle (the
+/// pass clears them to +0.0 and adds the block's shares; [`cross_gather`]
+/// then adds zero shares, which leave a sum that never was -0.0 bit for
+/// bit), and the deferred shares of cross-block pairs.
 pub struct Forces<'a> {
     /// Force per particle.
     pub f: &'a mut [V3],

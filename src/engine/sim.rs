@@ -240,28 +240,20 @@ impl Sim {
     /// `dt` (0 in the setup pass: LAMMPS and LIGGGHTS do not update shear
     /// history while `update->setupflag` is set).
     fn pair_forces_dt(&mut self, dt: f64) {
+        self.pair_virial = 0.0;
         let p = &mut self.particles;
-        if p.len() >= 2 * super::integrate::CHUNK {
-            use rayon::prelude::*;
-            // one parallel loop for both: each loop wakes the pool's workers
-            p.f.par_chunks_mut(super::integrate::CHUNK).zip(p.torque.par_chunks_mut(super::integrate::CHUNK)).for_each(|(f, t)| {
-                f.fill(V3::zeros());
-                t.fill(V3::zeros());
-            });
-        } else {
+        let Some(m) = &self.model else {
             p.f.fill(V3::zeros());
             p.torque.fill(V3::zeros());
-        }
-        self.pair_virial = 0.0;
-        if let Some(m) = &self.model {
-            let p = &mut self.particles;
-            let (mut f, mut torque) = (std::mem::take(&mut p.f), std::mem::take(&mut p.torque));
-            let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer };
-            self.pair_virial = m.kernel.force_pass(&self.particles, &mut self.pairs, &m.table, dt, force);
-            cross_gather(&self.pairs, &self.pair_defer, &mut f, &mut torque);
-            let p = &mut self.particles;
-            (p.f, p.torque) = (f, torque);
-        }
+            return;
+        };
+        // the force pass clears the forces block by block
+        let (mut f, mut torque) = (std::mem::take(&mut p.f), std::mem::take(&mut p.torque));
+        let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer };
+        self.pair_virial = m.kernel.force_pass(&self.particles, &mut self.pairs, &m.table, dt, force);
+        cross_gather(&self.pairs, &self.pair_defer, &mut f, &mut torque);
+        let p = &mut self.particles;
+        (p.f, p.torque) = (f, torque);
     }
 
     /// Forces at the start of a run (LAMMPS `Verlet::setup`).
