@@ -89,6 +89,9 @@ def prepare(quick):
     return bed
 
 
+CEILING = {}
+
+
 def tile_data(src, dst, nx, ny):
     """Copies of a periodic bed side by side in x and y (ids renumbered)."""
     box, atoms, vel, sec = {}, [], {}, None
@@ -153,6 +156,22 @@ def case(name, deck, engine, var, reps, threads=1, ranks=1, engine_deck=None):
     return row
 
 
+def ceiling(deck, var, reps):
+    """The machine's own limit for two threads: two one-thread demx runs at
+    once (separate processes, no shared data), their summed rate per run;
+    median over `reps`. Against one run alone it shows what two cores give
+    when both are busy (shared cache, memory, clock)."""
+    from concurrent.futures import ThreadPoolExecutor
+    sums = []
+    for _ in range(reps):
+        with ThreadPoolExecutor(2) as ex:
+            outs = list(ex.map(lambda _: run(demx_cmd(deck, 1, var), WORK)[0], range(2)))
+        sums.append(sum(rate(o)[0] for o in outs))
+    m = statistics.median(sums)
+    print(f"two one-thread runs at once: {m:.3e} together", flush=True)
+    return m
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--reps", type=int, default=5)
@@ -171,6 +190,7 @@ def main():
         rows.append(case("(a) settled bed, Hertz + history, 1 thread / 1 rank", bench("in.bed.liggghts"), "liggghts",
                          dict(data=big, nsteps=steps), a.reps))
     if "a2" in only:
+        CEILING["both"] = ceiling(bench("in.bed.liggghts"), dict(data=big, nsteps=steps), a.reps)
         rows.append(case("(a) bed, 2 threads / `mpirun -np 2`", bench("in.bed.liggghts"), "liggghts",
                          dict(data=big, nsteps=steps), a.reps, threads=2, ranks=2))
     if "b1" in only:
@@ -225,6 +245,11 @@ def write(a, rows, scaling):
         ratio = f"{r['demx'] / r['engine']:.2f}" if r["engine"] else "-"
         rss = f"{r['drss'] / 1024:.0f} / {r['erss'] / 1024:.0f}" if r["erss"] else f"{r['drss'] / 1024:.0f}"
         lines.append(f"| {r['name']} (demx --threads {r['threads']}) | {r['atoms']:,} | {r['demx']:.3e} | {eng} | {ratio} | {rss} |")
+    one = next((r["demx"] for r in rows if r["name"].startswith("(a) settled bed")), None)
+    if CEILING.get("both") and one:
+        lines += ["", f"What two cores give this machine: two one-thread demx runs of (a) at once (separate processes) ran at "
+                  f"{CEILING['both']:.3e} particle-steps/s together, {CEILING['both'] / one:.2f}x one run alone (median of {a.reps}); "
+                  "demx's own 2-thread figure is best read against that."]
     lines += ["", "Where the time goes (the median run's section timing, as each program prints it):", "",
               "| case | demx | engine |", "| --- | --- | --- |"]
     for r in rows:

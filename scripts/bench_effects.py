@@ -25,12 +25,17 @@ BEGIN, END = "<!-- effects:begin (scripts/bench_effects.py) -->", "<!-- effects:
 ROLL = "fix mr all property/global coefficientRollingFriction peratomtypepair 1 {mu}\n"
 COH = "fix mc all property/global cohesionEnergyDensity peratomtypepair 1 3000\n"
 PAIR = "pair_style      gran model hertz tangential history"
+PAPER = (ROLL.format(mu=0.1) + "fix mv all property/global restitutionReferenceVelocity scalar 1.0\n"
+         "fix ms all property/global surfaceEnergy peratomtypepair 1 0.05\n"
+         "fix md all property/global vdwMinDistance scalar 1.65e-10\nfix mx all property/global vdwCutoff scalar 1e-6\n")
 EFFECTS = [
     ("Hertz + tangential history (alone)", "", ""),
     ("+ rolling friction epsd2 (mu_r = 0.1)", " rolling_friction epsd2", ROLL.format(mu=0.1)),
     ("+ cohesion sjkr", " cohesion sjkr", COH),
     ("+ cohesion sjkr + rolling epsd2", " cohesion sjkr rolling_friction epsd2", COH + ROLL.format(mu=0.1)),
     ("+ rolling friction epsd2 with mu_r = 0", " rolling_friction epsd2", ROLL.format(mu=0.0)),
+    ("the paper's model (viscoelastic Hertz, history/paper, van der Waals, epsd/paper)",
+     "=model hertz/viscoelastic tangential history/paper cohesion vdw rolling_friction epsd/paper", PAPER),
 ]
 
 WIND_DECK = """# a sand bed settling onto a wall, periodic in x and y: 16 x 16 x 8 grains of
@@ -80,7 +85,9 @@ def bed_variant(extra_model, extra_props, steps, data):
     out = []
     for line in text.splitlines():
         w = line.split()
-        if line.startswith(PAIR):
+        if line.startswith(PAIR) and extra_model.startswith("="):
+            line = extra_props + "pair_style gran " + extra_model[1:]
+        elif line.startswith(PAIR):
             line = extra_props + PAIR + extra_model
         elif w[:2] == ["variable", "data"]:
             line = f"variable data index {data}"
