@@ -75,8 +75,8 @@ pub trait ContactKernel: Send + Sync {
     /// Force pass over the pair list, block by block (see [`Forces`]):
     /// sets each particle's force and torque to its pairs' sum (each block
     /// clears its particles' first, while they are in cache) and updates the
-    /// pairs' history; returns
-    /// the pair virial, the sum of r_ij . F_ij. Follow with [`cross_gather`].
+    /// pairs' history; returns the pair virial, the sum of r_ij . F_ij.
+    /// Follow with [`cross_gather`].
     fn force_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, force: Forces<'_>) -> f64;
     /// One contact with a wall or any other partner given as a `Contact`;
     /// history is zeroed when apart. Returns the laws' output.
@@ -534,7 +534,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             let delta = c.delta.0[l];
             let beyond = if C::NONCONTACT { delta <= -coeffs.p[l].extra_range } else { delta <= 0.0 };
             if beyond {
-                // within reach by r^2 but not by the overlap (rounding): apart
+                // within reach by r^2 but not by the overlap (rounding): apart,
+                // as the per-contact pass decides
                 hk.fill(0.0);
                 lv[pk - k.ps] = 0;
                 continue;
