@@ -81,11 +81,11 @@ impl Fix for WallGran {
         // history. Otherwise (moving wall, delayed checks) every particle is
         // tried every step.
         let ns = &sim.neigh;
-        let bounded = matches!(self.motion, WallMotion::None) && ns.check && ns.delay == 0 && ns.every <= 1;
+        let built = sim.pairs.x_built.len() == sim.particles.len();
+        let bounded = built && matches!(self.motion, WallMotion::None) && ns.check && ns.delay == 0 && ns.every <= 1;
         let build = sim.pairs.builds;
-        let built = bounded && sim.pairs.x_built.len() == sim.particles.len();
-        let reuse = built && self.candidates_at == Some(build);
-        let margin = if built { Some(sim.neigh.skin) } else { None };
+        let reuse = bounded && self.candidates_at == Some(build);
+        let margin = bounded.then_some(ns.skin);
         let this = &*self;
         let (group, width, w) = (this.group, this.width, this.width.max(1));
         let crate::engine::particles::Particles {
@@ -205,7 +205,7 @@ impl Fix for WallGran {
         } else {
             f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * w)).enumerate().map(body).collect()
         };
-        if built {
+        if bounded {
             self.candidates = near.concat();
             self.candidates_at = Some(build);
         } else {
