@@ -14,5 +14,6 @@ pub mod insert;
 pub mod mesh_surface;
 pub mod wind;
 pub mod guard;
+pub mod awake;
 
 pub use sim::{Dialect, Sim};

@@ -293,6 +293,8 @@ impl Sim {
             self.time += n as f64 * self.dt;
             return Ok(());
         }
+        // the other threads stay awake between the step's parallel loops
+        let _awake = super::awake::Awake::start();
         let t0 = Instant::now();
         for _ in 0..n {
             self.one_step(vars)?;
