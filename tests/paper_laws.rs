@@ -179,7 +179,7 @@ fn vdw_force_in_contact_midway_and_beyond_cutoff() {
     let p = params(0.2);
     let coh = |delta: f64| {
         let mut out = ContactOut::default();
-        Hamaker.cohesion(&pair(delta, V3::zeros(), V3::zeros(), V3::zeros(), 1e-8), &p, &mut [], &mut out);
+        Hamaker::default().cohesion(&pair(delta, V3::zeros(), V3::zeros(), V3::zeros(), 1e-8), &p, &mut [], &mut out);
         out.fn_coh
     };
     // in contact: A_H R*/(6 D_min^2) = 4 pi gamma R* = pi gamma d
@@ -192,9 +192,45 @@ fn vdw_force_in_contact_midway_and_beyond_cutoff() {
     assert_eq!(coh(-1.01 * D_MAX), 0.0);
     // walls are cohesionless
     let mut out = ContactOut::default();
-    Hamaker.cohesion(&wall(1e-7, V3::zeros(), V3::zeros(), 1e-8), &p, &mut [], &mut out);
+    Hamaker::default().cohesion(&wall(1e-7, V3::zeros(), V3::zeros(), 1e-8), &p, &mut [], &mut out);
     assert_eq!(out.fn_coh, 0.0);
     assert!(<Hamaker as CohesionLaw>::NONCONTACT);
+}
+
+/// The caps with van der Waals: Eq. 11's mu |F^c_n| and Eq. 15's mu_r R* |F^c_n|
+/// by default; with `tangential_reduce on` the net force |F^c_n - F_vdW|. At
+/// an overlap below the equilibrium one (F^c_n < F_vdW, the contact in
+/// tension) the two differ by far more than rounding.
+#[test]
+fn vdw_tangential_reduce_puts_the_attraction_into_both_caps() {
+    let p = params(0.2);
+    let dt = 1e-8;
+    let delta: f64 = 2e-9;
+    // Eq. 12 with R* = d/4, Eq. 13 in contact: pi gamma d
+    let k_n = 2.0 * Y / (3.0 * (1.0 - NU * NU)) * (D / 4.0).sqrt();
+    let f_c = k_n * delta.powf(1.5);
+    let f_vdw = std::f64::consts::PI * 0.05 * D;
+    assert!(f_c < 0.5 * f_vdw, "the contact should be in tension: {f_c} vs {f_vdw}");
+    let caps = |reduce: bool| {
+        // fast sliding along x and fast rolling about y: both laws at their caps
+        let c = pair(delta, V3::new(100.0, 0.0, 0.0), V3::new(0.0, 1e6, 0.0), V3::zeros(), dt);
+        let (mut hn, mut ht, mut hr) = ([0.0], [0.0; 3], [0.0; 3]);
+        let mut out = normal_out(&c, &p, &mut hn);
+        Hamaker { tangential_reduce: reduce }.cohesion(&c, &p, &mut [], &mut out);
+        assert!(rel(-out.fn_coh, f_vdw) < 1e-12, "the attraction itself does not change");
+        PaperCundallStrack.tangential(&c, &p, &mut ht, &mut out);
+        let ft = out.ft.norm();
+        let torque_before = out.torque_i;
+        PaperEpsd::default().rolling(&c, &p, &mut hr, &mut out);
+        (ft, (out.torque_i - torque_before).norm())
+    };
+    let (ft_off, mr_off) = caps(false);
+    assert!(rel(ft_off, 0.5 * f_c) < 1e-9, "{ft_off} vs {}", 0.5 * f_c);
+    assert!(rel(mr_off, 0.05 * D / 4.0 * f_c) < 1e-9);
+    let net = (f_c - f_vdw).abs();
+    let (ft_on, mr_on) = caps(true);
+    assert!(rel(ft_on, 0.5 * net) < 1e-9, "{ft_on} vs {}", 0.5 * net);
+    assert!(rel(mr_on, 0.05 * D / 4.0 * net) < 1e-9);
 }
 
 #[test]

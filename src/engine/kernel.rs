@@ -826,7 +826,7 @@ mod tests {
         use crate::physics::normal::viscoelastic::PaperViscoelastic;
         use crate::physics::rolling::paper::PaperEpsd;
         use crate::physics::tangential::paper::PaperCundallStrack;
-        let laws = Laws { normal: PaperViscoelastic, tangential: PaperCundallStrack, cohesion: Hamaker, rolling: PaperEpsd { torsion_torque: false } };
+        let laws = Laws { normal: PaperViscoelastic, tangential: PaperCundallStrack, cohesion: Hamaker { tangential_reduce: false }, rolling: PaperEpsd { torsion_torque: false } };
         assert!(Laws::<PaperViscoelastic, PaperCundallStrack, Hamaker, PaperEpsd>::BATCHED);
         let table = two_type_table(|q, s| {
             q.y_eff = 1e4 * s as f64;
@@ -841,6 +841,12 @@ mod tests {
         });
         let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
         assert_eq!(batched, scalar);
+        // with the attraction in the caps (tangential_reduce on): same bits
+        // both ways, and a different result (the caps bind in this bed)
+        let reduced = Laws { cohesion: Hamaker { tangential_reduce: true }, ..laws };
+        let (batched_r, scalar_r) = (passes(&reduced, &table, false), passes(&reduced, &table, true));
+        assert_eq!(batched_r, scalar_r);
+        assert_ne!(batched_r, batched, "tangential_reduce changed nothing");
         // pairs within D_max but apart exist in the bed, so the lanes' apart
         // branch is exercised
         let (p, _) = random_bed(11);

@@ -109,7 +109,11 @@ pub enum CohesionSpec {
         tangential_reduce: bool,
     },
     /// demx `cohesion vdw` (the paper's Hamaker force, Eqs. 13-14).
-    Vdw,
+    Vdw {
+        /// `tangential_reduce on`: the force also lowers the normal force of
+        /// the Coulomb and rolling caps (net force, as LIGGGHTS before 3.8).
+        tangential_reduce: bool,
+    },
 }
 
 /// Rolling law.
@@ -203,7 +207,7 @@ impl PairSpec {
         if self.tangential == TangentialSpec::PaperHistory {
             v.push("tangential history/paper");
         }
-        if self.cohesion == CohesionSpec::Vdw {
+        if matches!(self.cohesion, CohesionSpec::Vdw { .. }) {
             v.push("cohesion vdw");
         }
         if let RollingSpec::PaperEpsd { .. } = self.rolling {
@@ -234,7 +238,8 @@ impl PairSpec {
             CohesionSpec::Off => "none".to_string(),
             CohesionSpec::Sjkr { .. } => "sjkr".into(),
             CohesionSpec::Sjkr2 { .. } => "sjkr2".into(),
-            CohesionSpec::Vdw => "vdw".into(),
+            CohesionSpec::Vdw { tangential_reduce: false } => "vdw".into(),
+            CohesionSpec::Vdw { tangential_reduce: true } => "vdw (tangential_reduce on)".into(),
         };
         let r = match self.rolling {
             RollingSpec::Off => "none".to_string(),
@@ -301,7 +306,7 @@ fn lig_cohesion<N: NormalLaw + Send + 'static, T: TangentialLaw + Send + 'static
         CohesionSpec::Off => lig_rolling(n, t, NoCohesion, spec),
         CohesionSpec::Sjkr { tangential_reduce } => lig_rolling(n, t, LiggghtsSjkr { tangential_reduce }, spec),
         CohesionSpec::Sjkr2 { tangential_reduce } => lig_rolling(n, t, LiggghtsSjkr2 { tangential_reduce }, spec),
-        CohesionSpec::Vdw => lig_rolling(n, t, crate::physics::cohesion::vdw::Hamaker, spec),
+        CohesionSpec::Vdw { tangential_reduce } => lig_rolling(n, t, crate::physics::cohesion::vdw::Hamaker { tangential_reduce }, spec),
     }
 }
 
@@ -536,7 +541,7 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                     "off" => CohesionSpec::Off,
                     "sjkr" => CohesionSpec::Sjkr { tangential_reduce: false },
                     "sjkr2" => CohesionSpec::Sjkr2 { tangential_reduce: false },
-                    "vdw" => CohesionSpec::Vdw,
+                    "vdw" => CohesionSpec::Vdw { tangential_reduce: false },
                     "easo/capillary/viscous" | "washino/capillary/viscous" => {
                         return Err(Error::unsupported(c.span, format!("cohesion model '{}'", c.text)))
                     }
@@ -564,54 +569,67 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                     _ => return Err(bad_keyword(sfc, "surface model", &["default"])),
                 }
             }
-            "tangential_damping" => spec.tangential_damping = a.yes_no("tangential_damping")?,
-            "limitForce" => spec.limit_damping = a.yes_no("limitForce")?,
-            "ktToKnUser" => {
-                let on = a.yes_no("ktToKnUser")?;
-                if let NormalSpec::LigHooke { kt_to_kn } = &mut spec.normal {
-                    *kt_to_kn = on;
-                }
-            }
-            "absolute_damping" => {
-                let on = a.yes_no("absolute_damping")?;
-                if let NormalSpec::LigHookeStiffness { absolute } = &mut spec.normal {
-                    *absolute = on;
-                }
-            }
-            "torsionTorque" => {
-                let on = a.yes_no("torsionTorque")?;
-                match &mut spec.rolling {
-                    RollingSpec::Epsd { torsion }
-                    | RollingSpec::Epsd2 { torsion }
-                    | RollingSpec::Epsd3 { torsion }
-                    | RollingSpec::PaperEpsd { torsion } => *torsion = on,
-                    _ => {}
-                }
-            }
-            "tangential_reduce" => {
-                let on = a.yes_no("tangential_reduce")?;
-                match &mut spec.cohesion {
-                    CohesionSpec::Sjkr { tangential_reduce } | CohesionSpec::Sjkr2 { tangential_reduce } => *tangential_reduce = on,
-                    _ => {}
-                }
-            }
-            "heating_normal_hertz" | "computeDissipatedEnergy" | "computeElasticPotential" | "disableNormalWhenBonded" => {
-                let v = a.yes_no(&k.text.clone())?;
-                if v && k.text != "computeDissipatedEnergy" && k.text != "computeElasticPotential" {
-                    return Err(Error::unsupported(k.span, format!("model option {} on", k.text)));
-                }
-            }
-            "viscous" => return Err(Error::unsupported(k.span, "hooke model option viscous")),
+            _ if model_keyword(&k, a, spec)? => {}
             _ => {
                 return Err(bad_keyword(
                     k,
                     "pair_style gran keyword",
-                    &["tangential", "cohesion", "rolling_friction", "surface", "tangential_damping", "limitForce", "ktToKnUser", "absolute_damping"],
+                    &["tangential", "cohesion", "rolling_friction", "surface", "tangential_damping", "limitForce", "ktToKnUser", "absolute_damping", "torsionTorque", "tangential_reduce"],
                 ))
             }
         }
     }
     Ok(())
+}
+
+/// One LIGGGHTS model keyword and its value (`tangential_damping on`,
+/// `tangential_reduce on`, ...), as the pair style and `fix wall/gran` (before
+/// or after the wall's geometry) take them; false when `k` is none.
+pub fn model_keyword(k: &Word, a: &mut Args, spec: &mut PairSpec) -> Result<bool> {
+    match k.text.as_str() {
+        "tangential_damping" => spec.tangential_damping = a.yes_no("tangential_damping")?,
+        "limitForce" => spec.limit_damping = a.yes_no("limitForce")?,
+        "ktToKnUser" => {
+            let on = a.yes_no("ktToKnUser")?;
+            if let NormalSpec::LigHooke { kt_to_kn } = &mut spec.normal {
+                *kt_to_kn = on;
+            }
+        }
+        "absolute_damping" => {
+            let on = a.yes_no("absolute_damping")?;
+            if let NormalSpec::LigHookeStiffness { absolute } = &mut spec.normal {
+                *absolute = on;
+            }
+        }
+        "torsionTorque" => {
+            let on = a.yes_no("torsionTorque")?;
+            match &mut spec.rolling {
+                RollingSpec::Epsd { torsion }
+                | RollingSpec::Epsd2 { torsion }
+                | RollingSpec::Epsd3 { torsion }
+                | RollingSpec::PaperEpsd { torsion } => *torsion = on,
+                _ => {}
+            }
+        }
+        "tangential_reduce" => {
+            let on = a.yes_no("tangential_reduce")?;
+            match &mut spec.cohesion {
+                CohesionSpec::Sjkr { tangential_reduce } | CohesionSpec::Sjkr2 { tangential_reduce } | CohesionSpec::Vdw { tangential_reduce } => {
+                    *tangential_reduce = on
+                }
+                _ => {}
+            }
+        }
+        "heating_normal_hertz" | "computeDissipatedEnergy" | "computeElasticPotential" | "disableNormalWhenBonded" => {
+            let v = a.yes_no(&k.text.clone())?;
+            if v && k.text != "computeDissipatedEnergy" && k.text != "computeElasticPotential" {
+                return Err(Error::unsupported(k.span, format!("model option {} on", k.text)));
+            }
+        }
+        "viscous" => return Err(Error::unsupported(k.span, "hooke model option viscous")),
+        _ => return Ok(false),
+    }
+    Ok(true)
 }
 
 /// One LAMMPS granular `pair_coeff` as parsed: normal, tangential and
@@ -870,7 +888,7 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
             if spec.normal == NormalSpec::PaperViscoelastic {
                 needed.push(("restitutionReferenceVelocity", scalar("restitutionReferenceVelocity").is_some()));
             }
-            if spec.cohesion == CohesionSpec::Vdw {
+            if matches!(spec.cohesion, CohesionSpec::Vdw { .. }) {
                 needed.push(("surfaceEnergy", surface_energy.is_some()));
                 needed.push(("vdwMinDistance", scalar("vdwMinDistance").is_some()));
                 needed.push(("vdwCutoff", scalar("vdwCutoff").is_some()));
@@ -905,7 +923,7 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                     })?;
                 }
             }
-            if spec.cohesion == CohesionSpec::Vdw {
+            if matches!(spec.cohesion, CohesionSpec::Vdw { .. }) {
                 let d_min = scalar("vdwMinDistance").unwrap_or(0.0);
                 let d_max = scalar("vdwCutoff").unwrap_or(0.0);
                 if !(d_min > 0.0) || !(d_max >= 0.0) || !d_min.is_finite() || !d_max.is_finite() {

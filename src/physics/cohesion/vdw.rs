@@ -9,8 +9,17 @@
 //! attractive, with A_H = 24 pi D_min^2 gamma (Eq. 14, gamma the surface
 //! energy) and R* = R_i R_j / (R_i + R_j) (Derjaguin; d/4 for equal spheres).
 //! Walls are cohesionless (paper, Model Parameters): no force on wall
-//! contacts. The force does not enter the Coulomb or rolling caps (they use
-//! the contact force F^c_n only).
+//! contacts.
+//!
+//! The caps: Eqs. 11 and 15 bound friction and rolling by the contact force
+//! |F^c_n| alone, and so does demx by default (as LIGGGHTS 3.8's cohesion
+//! models by default: `tangential_reduce off`). With `tangential_reduce on`
+//! the caps use the net normal force |F^c_n + F^a_n|, as LIGGGHTS's cohesion
+//! did unconditionally before 3.8 (its 2.x pair styles and early 3.x
+//! cohesion models add the cohesive force to the normal force that the
+//! tangential and rolling models read); the paper's code extended LIGGGHTS
+//! of that time (its ref. 15). A bonded contact at rest then has a net
+//! normal force near zero, so it can roll and slide while it holds.
 
 use crate::physics::lanes::{Coeffs, Real};
 use crate::physics::{on_one, CohesionLaw, Contact, ContactL, ContactOut, OutL, PairParams};
@@ -19,7 +28,11 @@ use crate::physics::{on_one, CohesionLaw, Contact, ContactL, ContactOut, OutL, P
 /// `hamaker` (A_H), `d_min`, `d_max`; the scene sets `extra_range = d_max` so
 /// the neighbour list includes pairs up to D_max apart.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Hamaker;
+pub struct Hamaker {
+    /// `tangential_reduce on`: the attraction lowers the normal force of the
+    /// Coulomb and rolling caps (in contact only; apart pairs have no caps).
+    pub tangential_reduce: bool,
+}
 
 impl CohesionLaw for Hamaker {
     const HISTORY: usize = 0;
@@ -40,6 +53,10 @@ impl CohesionLaw for Hamaker {
         // beyond D_max
         let dist = R::select(c.delta.gt(zero), d_min, d_min - c.delta);
         let f = p.get(|q| q.hamaker) * c.r_eff / (dist * 6.0 * dist);
-        out.fn_coh -= R::select(c.delta.lt(-d_max), zero, f);
+        let f_coh = R::select(c.delta.lt(-d_max), zero, f);
+        out.fn_coh -= f_coh;
+        if self.tangential_reduce {
+            out.fn_for_friction -= f_coh;
+        }
     }
 }
