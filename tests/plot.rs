@@ -186,6 +186,11 @@ fn repose_plot_draws_both_projections() {
     let (code, stdout, stderr) = demx(&["repose", d.to_str().unwrap(), "--plot", out.to_str().unwrap()], &[]);
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.contains("theta_r"), "{stdout}");
+    // the Bond number says which surface energy it assumed, and takes --gamma
+    assert!(stdout.contains("with gamma = 0.05 J/m^2"), "{stdout}");
+    let (_, stdout_g, _) = demx(&["repose", d.to_str().unwrap(), "--gamma", "0.5"], &[]);
+    let bo = |s: &str| -> f64 { s.split("rho) = ").nth(1).and_then(|t| t.split_whitespace().next()).and_then(|x| x.parse().ok()).unwrap() };
+    assert!((bo(&stdout_g) / bo(&stdout) - 10.0).abs() < 1e-9, "{stdout_g}");
     let img = read_png(&out);
     assert_eq!((img.w, img.h), (2 * PANEL_SIZE.0, PANEL_SIZE.1));
     // boundary (first colour) and triangle (second) in each panel

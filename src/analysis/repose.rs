@@ -321,7 +321,16 @@ pub fn cli(args: Vec<String>) -> ExitCode {
             } else {
                 println!("theta_r = {:.2} +- {:.2} deg (x-z {:.2}, y-z {:.2})", r.theta, r.sd, r.theta_xz, r.theta_yz);
                 println!("heap height {:.4e} m, {} particles, d = {:.4e} m", r.height, r.particles, r.diameter);
-                println!("Bond number Bo = 12 gamma/(d^2 g rho) = {bo:.4e}: {}", regime(bo));
+                // the dump does not know the deck's surface energy, gravity or
+                // density: say which ones the Bond number assumed
+                println!(
+                    "Bond number Bo = 12 gamma/(d^2 g rho) = {bo:.4e} with gamma = {} J/m^2, g = {} m/s^2, rho = {} kg/m^3 \
+                     (the paper's glass unless --gamma/--g/--rho): {}",
+                    c.gamma,
+                    c.g,
+                    c.rho,
+                    regime(bo)
+                );
             }
             ExitCode::SUCCESS
         }
