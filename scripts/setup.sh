@@ -17,5 +17,5 @@ if [ ${#need[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null
 fi
-liggghts -h 2>/dev/null | head -1 >&2 || true
+(cd "${TMPDIR:-/tmp}" && liggghts -h 2>/dev/null | head -1 >&2) || true  # -h writes log.liggghts in the working directory
 lmp -h 2>/dev/null | sed -n 2p >&2 || true
