@@ -34,7 +34,7 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from heaprun import ROOT, write_section
 Y_PAPER = 63e9
 GAMMA_PAPER = 0.05
 SEEDS = [15485863, 49979687, 67867967, 86028121, 104395301]
@@ -152,12 +152,7 @@ def main():
         else:
             lines.append(f"| {y:g} | {g:.3g} | {why} | {bo:.3g} | 0 | failed: {rs[0].get('error', '?')[:60]} | - | - |")
     lines += ["", "Command: `python3 scripts/heap_cohesion.py " + " ".join(sys.argv[1:]) + "`", ""]
-    os.makedirs(os.path.dirname(a.out), exist_ok=True)
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(lines))
-    os.replace(tmp, a.out)
-    print("\n".join(lines))
+    write_section(a.out, lines)
 
 
 if __name__ == "__main__":

@@ -33,32 +33,13 @@ import argparse
 import json
 import math
 import os
-import re
 import subprocess
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from heaprun import ROOT, repose, work_done
+
 WORK = os.path.join(ROOT, "target", "heap_size")
-
-
-def repose(demx, dump):
-    r = subprocess.run([demx, "repose", dump, "--json", "--gamma", "1e-30"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if r.returncode != 0:
-        return None
-    return json.loads(r.stdout)["repose"]
-
-
-def work_done(log):
-    """Steps and particle-steps of a run, from its `Loop time ... for S steps
-    with A atoms` lines (A at the end of each run command)."""
-    steps = psteps = 0
-    for line in open(log):
-        m = re.match(r"Loop time of \S+ on \d+ procs for (\d+) steps with (\d+) atoms", line)
-        if m:
-            steps += int(m.group(1))
-            psteps += int(m.group(1)) * int(m.group(2))
-    return steps, psteps
 
 
 def main():
