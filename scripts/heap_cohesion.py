@@ -59,7 +59,9 @@ def run_one(demx, d, n, y, gamma, seed):
     with tempfile.TemporaryDirectory(prefix="demx-heap-") as work:
         cmd = [demx, "run", os.path.join(ROOT, "templates/heap/in.heap"), "--threads", "1", "--quiet", "--log", "none",
                "-var", "model", "paper", "-var", "d", repr(d), "-var", "N", str(n), "-var", "Y", repr(y),
-               "-var", "gamma", repr(gamma), "-var", "seed", str(seed)]
+               "-var", "gamma", repr(gamma), "-var", "seed", str(seed),
+               # the caps of this table: the contact force alone (the template's default until 2026-12-02)
+               "-var", "reduce", "off"]
         t0 = time.time()
         p = subprocess.run(cmd, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         wall = time.time() - t0
