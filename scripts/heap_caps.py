@@ -106,7 +106,7 @@ def main():
     groups = {}
     for res in cache.data.values():
         groups.setdefault((res["d"], res["n"], res["Y"], res["gamma"], res["reduce"]), []).append(res)
-    for (d, n, y, gamma, r) in sorted(groups, key=lambda g: (g[3], g[2], -g[0], g[1], g[4])):
+    for (d, n, y, gamma, r) in sorted(groups, key=lambda g: (g[3], -g[2], -g[0], g[1], g[4])):
         ok = groups[(d, n, y, gamma, r)]
         bo = 12 * gamma / (d ** 2 * 9.81 * 2500)
         eq1 = math.degrees(math.atan(MU_INF * (1 + D_E / d)))
