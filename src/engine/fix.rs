@@ -4,7 +4,66 @@
 
 use super::sim::Sim;
 use crate::error::Result;
+use crate::physics::V3;
 use crate::script::Variables;
+
+/// The two hooks after the pair forces that may run particle by particle,
+/// fused into one pass over the particles (see [`Fix::local`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hook {
+    /// [`Fix::post_force`].
+    PostForce,
+    /// [`Fix::final_integrate`].
+    FinalIntegrate,
+}
+
+/// How a fix takes part in a hook at this step.
+pub enum Local {
+    /// The hook does nothing at this step.
+    Nothing,
+    /// The hook changes each particle from that particle's own entries
+    /// alone, so the step may run it chunk by chunk, fused with the stages
+    /// around it: every particle still meets the stages in the fixes' order,
+    /// so each particle's sums are the same bits as with one pass per hook.
+    Stage(Box<dyn Stage>),
+    /// The hook needs the whole simulation: it is called as it is.
+    Whole,
+}
+
+/// A hook's per-particle form.
+pub trait Stage: Send + Sync {
+    /// Apply to the particles of `c`.
+    fn apply(&self, c: &mut Chunk<'_>);
+}
+
+/// The particles `lo..lo + v.len()` of a fused pass: their own entries to
+/// change, and the whole arrays that no stage changes, to read (indexed by
+/// particle).
+pub struct Chunk<'a> {
+    /// Index of the chunk's first particle.
+    pub lo: usize,
+    /// Positions (all particles).
+    pub x: &'a [V3],
+    /// Radii (all particles).
+    pub radius: &'a [f64],
+    /// Masses (all particles).
+    pub mass: &'a [f64],
+    /// Types (all particles).
+    pub kind: &'a [u32],
+    /// Group bits (all particles).
+    pub mask: &'a [u32],
+    /// The chunk's velocities.
+    pub v: &'a mut [V3],
+    /// The chunk's angular velocities.
+    pub omega: &'a mut [V3],
+    /// The chunk's forces.
+    pub f: &'a mut [V3],
+    /// The chunk's torques.
+    pub torque: &'a mut [V3],
+    /// The chunk's entries of each extra per-atom column (`width` values per
+    /// particle, in the order of `Particles::extra`).
+    pub extra: Vec<&'a mut [f64]>,
+}
 
 /// A fix (LAMMPS `fix ID group style ...`). Hooks get the whole simulation
 /// with this fix taken out of it for the call.
@@ -38,6 +97,14 @@ pub trait Fix: Send {
     }
     /// Integration, second half.
     fn final_integrate(&mut self, _sim: &mut Sim) {}
+    /// How this fix's `hook` acts at this step: not at all, particle by
+    /// particle (a [`Stage`], run fused with its neighbours instead of the
+    /// hook), or on the whole simulation (the hook is called). Called in the
+    /// hooks' order, but before earlier fixes' stages have run, so a stage
+    /// must not depend on what they change. The default calls the hook.
+    fn local(&mut self, _hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
+        Ok(Local::Whole)
+    }
     /// End of step (print, ave/time, checks).
     fn end_of_step(&mut self, _sim: &mut Sim, _vars: &Variables) -> Result<()> {
         Ok(())
@@ -96,9 +163,27 @@ pub fn deepest_overlap(sim: &Sim, group: u32, overlap: impl Fn(usize) -> Option<
     worst
 }
 
+/// [`Fix::local`] for a fix that has neither a post_force nor a
+/// final_integrate: nothing at either hook, so it does not split the step's
+/// fused tail.
+#[macro_export]
+macro_rules! no_force_hooks {
+    () => {
+        fn local(
+            &mut self,
+            _hook: $crate::engine::fix::Hook,
+            _sim: &$crate::engine::sim::Sim,
+            _vars: &$crate::script::Variables,
+        ) -> $crate::error::Result<$crate::engine::fix::Local> {
+            Ok($crate::engine::fix::Local::Nothing)
+        }
+    };
+}
+
 /// Placeholder put in a fix's slot while its hook runs.
 pub struct Hole;
 impl Fix for Hole {
+    crate::no_force_hooks!();
     fn id(&self) -> &str {
         ""
     }

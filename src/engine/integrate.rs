@@ -1,6 +1,7 @@
 //! Velocity-Verlet for spheres (`fix nve/sphere`), in the same order of
 //! operations as LAMMPS `FixNVESphere`, so demx and the engines stay in step.
 
+use super::fix::{Chunk, Stage};
 use super::particles::Particles;
 use crate::physics::V3;
 use rayon::prelude::*;
@@ -100,14 +101,43 @@ pub fn initial_integrate(p: &mut Particles, group: u32, dt: f64) {
 
 /// Second half: v += dt/2 f/m; omega += dt/2 torque/I.
 pub fn final_integrate(p: &mut Particles, group: u32, dt: f64) {
-    let dtf = 0.5 * dt;
-    let dtfrot = dtf / INERTIA;
-    each_in_group(p, group, |h, i, _x, v, w| {
-        let dtfm = dtf / h.mass[i];
-        *v += h.f[i] * dtfm;
-        let dtirotate = dtfrot / (h.radius[i] * h.radius[i] * h.mass[i]);
-        *w += h.torque[i] * dtirotate;
-    });
+    let s = FinalHalf { group, dt, rotate: true };
+    each_in_group(p, group, |h, i, _x, v, w| s.one(h.f[i], h.torque[i], h.mass[i], h.radius[i], v, w));
+}
+
+/// The second half of `fix nve/sphere` (`rotate`) or `fix nve`, particle by
+/// particle: the form the step's fused tail runs (a [`Stage`]).
+pub struct FinalHalf {
+    /// The fix's group bit.
+    pub group: u32,
+    /// Time step.
+    pub dt: f64,
+    /// Whether angular velocity is integrated (nve/sphere) or left (nve).
+    pub rotate: bool,
+}
+
+impl FinalHalf {
+    #[inline(always)]
+    fn one(&self, f: V3, torque: V3, m: f64, r: f64, v: &mut V3, w: &mut V3) {
+        let dtf = 0.5 * self.dt;
+        let dtfm = dtf / m;
+        *v += f * dtfm;
+        if self.rotate {
+            let dtirotate = dtf / INERTIA / (r * r * m);
+            *w += torque * dtirotate;
+        }
+    }
+}
+
+impl Stage for FinalHalf {
+    fn apply(&self, c: &mut Chunk<'_>) {
+        for q in 0..c.v.len() {
+            let i = c.lo + q;
+            if c.mask[i] & self.group != 0 {
+                self.one(c.f[q], c.torque[q], c.mass[i], c.radius[i], &mut c.v[q], &mut c.omega[q]);
+            }
+        }
+    }
 }
 
 /// `fix nve` first half: translation only (LAMMPS `FixNVE`); angular
@@ -123,11 +153,8 @@ pub fn initial_integrate_nve(p: &mut Particles, group: u32, dt: f64) {
 
 /// `fix nve` second half.
 pub fn final_integrate_nve(p: &mut Particles, group: u32, dt: f64) {
-    let dtf = 0.5 * dt;
-    each_in_group(p, group, |h, i, _x, v, _w| {
-        let dtfm = dtf / h.mass[i];
-        *v += h.f[i] * dtfm;
-    });
+    let s = FinalHalf { group, dt, rotate: false };
+    each_in_group(p, group, |h, i, _x, v, w| s.one(h.f[i], h.torque[i], h.mass[i], h.radius[i], v, w));
 }
 
 #[cfg(test)]

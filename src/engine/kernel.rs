@@ -578,19 +578,24 @@ pub fn cross_gather(pairs: &PairList, defer: &[[V3; 2]], f: &mut [V3], torque: &
         return;
     }
     let bs = pairs.block_size();
-    f.par_chunks_mut(bs).zip(torque.par_chunks_mut(bs)).enumerate().for_each(|(ci, (fc, tc))| {
-        for q in 0..fc.len() {
-            let i = ci * bs + q;
-            let (s, e) = (pairs.cross_start[i] as usize, pairs.cross_start[i + 1] as usize);
-            // apart pairs add zeros, which leave every bit as it is: the
-            // sums started from +0.0, so they are never -0.0
-            for &slot in &pairs.cross[s..e] {
-                let o = &defer[slot as usize];
-                fc[q] -= o[0];
-                tc[q] += o[1];
-            }
+    f.par_chunks_mut(bs).zip(torque.par_chunks_mut(bs)).enumerate().for_each(|(ci, (fc, tc))| cross_gather_chunk(pairs, defer, ci * bs, fc, tc));
+}
+
+/// [`cross_gather`] for the particles `lo..lo + f.len()` alone (`f` and
+/// `torque` are theirs).
+#[inline]
+pub fn cross_gather_chunk(pairs: &PairList, defer: &[[V3; 2]], lo: usize, f: &mut [V3], torque: &mut [V3]) {
+    for q in 0..f.len() {
+        let i = lo + q;
+        let (s, e) = (pairs.cross_start[i] as usize, pairs.cross_start[i + 1] as usize);
+        // apart pairs add zeros, which leave every bit as it is: the
+        // sums started from +0.0, so they are never -0.0
+        for &slot in &pairs.cross[s..e] {
+            let o = &defer[slot as usize];
+            f[q] -= o[0];
+            torque[q] += o[1];
         }
-    });
+    }
 }
 
 #[cfg(test)]

@@ -2,8 +2,8 @@
 
 use super::compute::Compute;
 use super::domain::Domain;
-use super::fix::{Fix, Hole};
-use super::kernel::{cross_gather, ContactKernel, Forces, ParamTable};
+use super::fix::{Chunk, Fix, Hole, Hook, Local, Stage};
+use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable};
 use super::neighbor::{NeighSettings, PairList};
 use super::output::{Dump, Logger, Thermo};
 use super::particles::Particles;
@@ -11,6 +11,25 @@ use crate::error::{Error, Result};
 use crate::physics::V3;
 use crate::script::{EvalContext, Variables};
 use std::time::Instant;
+
+/// Particles per chunk of the step's fused tail ([`Sim::tail`]): small enough
+/// that a chunk's entries stay in cache from one stage to the next, and that
+/// two threads get equal shares of a 30,000-particle bed.
+const TAIL_CHUNK: usize = 1024;
+
+thread_local! {
+    /// Tests set it to call every hook of the tail on its own, as one pass
+    /// per hook, to check that the fused tail gives the same bits.
+    static UNFUSED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Run `f` with the step's tail unfused on this thread (tests).
+pub fn with_unfused_tail<T>(f: impl FnOnce() -> T) -> T {
+    UNFUSED.with(|u| u.set(true));
+    let r = f();
+    UNFUSED.with(|u| u.set(false));
+    r
+}
 
 /// Which engine's conventions a deck follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -240,6 +259,14 @@ impl Sim {
     /// `dt` (0 in the setup pass: LAMMPS and LIGGGHTS do not update shear
     /// history while `update->setupflag` is set).
     fn pair_forces_dt(&mut self, dt: f64) {
+        self.pair_pass(dt);
+        let p = &mut self.particles;
+        cross_gather(&self.pairs, &self.pair_defer, &mut p.f, &mut p.torque);
+    }
+
+    /// The force pass of [`Sim::pair_forces_dt`] without its cross pass,
+    /// which the step's fused tail runs (`tail`).
+    fn pair_pass(&mut self, dt: f64) {
         self.pair_virial = 0.0;
         let p = &mut self.particles;
         let Some(m) = &self.model else {
@@ -251,7 +278,6 @@ impl Sim {
         let (mut f, mut torque) = (std::mem::take(&mut p.f), std::mem::take(&mut p.torque));
         let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer };
         self.pair_virial = m.kernel.force_pass(&self.particles, &mut self.pairs, &m.table, dt, force);
-        cross_gather(&self.pairs, &self.pair_defer, &mut f, &mut torque);
         let p = &mut self.particles;
         (p.f, p.torque) = (f, torque);
     }
@@ -326,14 +352,10 @@ impl Sim {
         }
         let tn = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        self.pair_forces();
+        self.pair_pass(self.dt);
         let tp = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        self.each_fix(|f, s| f.post_force(s, vars))?;
-        self.each_fix(|f, s| {
-            f.final_integrate(s);
-            Ok(())
-        })?;
+        self.tail(vars)?;
         self.each_fix(|f, s| f.end_of_step(s, vars))?;
         if self.guard.due(self.step) {
             super::guard::check(self, false)?;
@@ -346,6 +368,96 @@ impl Sim {
         self.timing[2] += tm + tm2;
         self.timing[3] += t.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// The step after the pair pass: the cross-block shares of the pair
+    /// forces, then every fix's post_force, then every fix's final_integrate,
+    /// in LAMMPS order. Hooks that act particle by particle ([`Fix::local`])
+    /// run fused, chunk by chunk, so a bed's forces and velocities pass
+    /// through the cache once instead of once per hook; each particle meets
+    /// the same operations in the same order, so the bits are those of one
+    /// pass per hook. A hook that needs the whole simulation ends the fused
+    /// run before it and is called as it is.
+    fn tail(&mut self, vars: &Variables) -> Result<()> {
+        let mut stages: Vec<Box<dyn Stage>> = vec![];
+        let mut gather = true;
+        let fuse = !UNFUSED.with(|u| u.get());
+        for hook in [Hook::PostForce, Hook::FinalIntegrate] {
+            for k in 0..self.fixes.len() {
+                let mut fix = std::mem::replace(&mut self.fixes[k], Box::new(Hole));
+                let local = if fuse { fix.local(hook, self, vars) } else { Ok(Local::Whole) };
+                let local = match local {
+                    Ok(Local::Whole) => {
+                        self.fused(&mut stages, &mut gather);
+                        match hook {
+                            Hook::PostForce => fix.post_force(self, vars).map(|_| Local::Nothing),
+                            Hook::FinalIntegrate => {
+                                fix.final_integrate(self);
+                                Ok(Local::Nothing)
+                            }
+                        }
+                    }
+                    other => other,
+                };
+                self.fixes[k] = fix;
+                if let Local::Stage(st) = local? {
+                    stages.push(st);
+                }
+            }
+        }
+        self.fused(&mut stages, &mut gather);
+        Ok(())
+    }
+
+    /// Run the pending cross pass (when `gather`) and `stages` over the
+    /// particles in fixed chunks, in parallel from two chunks up; empties both.
+    fn fused(&mut self, stages: &mut Vec<Box<dyn Stage>>, gather: &mut bool) {
+        if stages.is_empty() && !*gather {
+            return;
+        }
+        let cross = std::mem::take(gather) && !self.pairs.cross.is_empty();
+        let (pairs, defer) = (&self.pairs, &self.pair_defer[..]);
+        let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, .. } = &mut self.particles;
+        let n = x.len();
+        let (x, radius, mass, kind, mask) = (&x[..], &radius[..], &mass[..], &kind[..], &mask[..]);
+        // each extra column cut at the chunks
+        let mut cols: Vec<std::slice::ChunksMut<'_, f64>> = extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(TAIL_CHUNK * e.width.max(1))).collect();
+        let jobs: Vec<Chunk<'_>> = v
+            .chunks_mut(TAIL_CHUNK)
+            .zip(omega.chunks_mut(TAIL_CHUNK))
+            .zip(f.chunks_mut(TAIL_CHUNK))
+            .zip(torque.chunks_mut(TAIL_CHUNK))
+            .enumerate()
+            .map(|(c, (((v, omega), f), torque))| Chunk {
+                lo: c * TAIL_CHUNK,
+                x,
+                radius,
+                mass,
+                kind,
+                mask,
+                v,
+                omega,
+                f,
+                torque,
+                extra: cols.iter_mut().map(|it| it.next().unwrap_or_default()).collect(),
+            })
+            .collect();
+        let pending = &*stages;
+        let run = |mut c: Chunk<'_>| {
+            if cross {
+                cross_gather_chunk(pairs, defer, c.lo, c.f, c.torque);
+            }
+            for st in pending {
+                st.apply(&mut c);
+            }
+        };
+        if jobs.len() > 1 {
+            use rayon::prelude::*;
+            jobs.into_par_iter().for_each(run);
+        } else {
+            jobs.into_iter().for_each(run);
+        }
+        stages.clear();
     }
 
     /// Thermo and dumps due at this step.

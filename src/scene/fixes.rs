@@ -2,7 +2,7 @@
 //! setforce. Each holds its group bit and parsed arguments.
 
 use super::args::Args;
-use crate::engine::fix::Fix;
+use crate::engine::fix::{Chunk, Fix, Hook, Local, Stage};
 use crate::engine::integrate;
 use crate::engine::sim::Sim;
 use crate::error::{Error, Result};
@@ -30,6 +30,12 @@ impl Fix for NveSphere {
     fn final_integrate(&mut self, sim: &mut Sim) {
         integrate::final_integrate(&mut sim.particles, self.group, sim.dt);
     }
+    fn local(&mut self, hook: Hook, sim: &Sim, _vars: &Variables) -> Result<Local> {
+        Ok(match hook {
+            Hook::PostForce => Local::Nothing,
+            Hook::FinalIntegrate => Local::Stage(Box::new(integrate::FinalHalf { group: self.group, dt: sim.dt, rotate: true })),
+        })
+    }
     fn integrates(&self) -> bool {
         true
     }
@@ -55,6 +61,12 @@ impl Fix for Nve {
     }
     fn final_integrate(&mut self, sim: &mut Sim) {
         integrate::final_integrate_nve(&mut sim.particles, self.group, sim.dt);
+    }
+    fn local(&mut self, hook: Hook, sim: &Sim, _vars: &Variables) -> Result<Local> {
+        Ok(match hook {
+            Hook::PostForce => Local::Nothing,
+            Hook::FinalIntegrate => Local::Stage(Box::new(integrate::FinalHalf { group: self.group, dt: sim.dt, rotate: false })),
+        })
     }
     fn integrates(&self) -> bool {
         true
@@ -114,16 +126,7 @@ impl Fix for Gravity {
             self.acc = self.dir * m;
         }
         let p = &mut sim.particles;
-        let (acc, group) = (self.acc, self.group);
-        // each particle on its own: the same bits on any thread count
-        let pull = |f: &mut [V3], mask: &[u32], mass: &[f64]| {
-            for ((f, &bits), &m) in f.iter_mut().zip(mask).zip(mass) {
-                if bits & group != 0 {
-                    // LAMMPS FixGravity: f += rmass * xacc (per component)
-                    *f += V3::new(m * acc.x, m * acc.y, m * acc.z);
-                }
-            }
-        };
+        let pull = |f: &mut [V3], mask: &[u32], mass: &[f64]| Pull { acc: self.acc, group: self.group }.pull(f, mask, mass);
         let chunk = integrate::CHUNK;
         if p.len() >= 2 * chunk {
             use rayon::prelude::*;
@@ -133,11 +136,46 @@ impl Fix for Gravity {
         }
         Ok(())
     }
+    fn local(&mut self, hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
+        Ok(match (hook, &self.magnitude) {
+            (Hook::PostForce, Magnitude::Const(_)) => Local::Stage(Box::new(Pull { acc: self.acc, group: self.group })),
+            (Hook::PostForce, Magnitude::Var(_)) => Local::Whole,
+            (Hook::FinalIntegrate, _) => Local::Nothing,
+        })
+    }
     fn summary(&self) -> String {
         format!("gravity {:?} (fix {})", [self.acc.x, self.acc.y, self.acc.z], self.id)
     }
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)
+    }
+}
+
+/// Gravity's pull on each particle of a group (the post_force of
+/// [`Gravity`], and its stage in the step's fused tail).
+struct Pull {
+    acc: V3,
+    group: u32,
+}
+
+impl Pull {
+    /// Each particle on its own: the same bits on any thread count.
+    #[inline(always)]
+    fn pull(&self, f: &mut [V3], mask: &[u32], mass: &[f64]) {
+        let acc = self.acc;
+        for ((f, &bits), &m) in f.iter_mut().zip(mask).zip(mass) {
+            if bits & self.group != 0 {
+                // LAMMPS FixGravity: f += rmass * xacc (per component)
+                *f += V3::new(m * acc.x, m * acc.y, m * acc.z);
+            }
+        }
+    }
+}
+
+impl Stage for Pull {
+    fn apply(&self, c: &mut Chunk<'_>) {
+        let r = c.lo..c.lo + c.f.len();
+        self.pull(c.f, &c.mask[r.clone()], &c.mass[r]);
     }
 }
 
@@ -319,6 +357,7 @@ pub struct Print {
 }
 
 impl Fix for Print {
+    crate::no_force_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -484,6 +523,7 @@ impl AveTime {
 }
 
 impl Fix for AveTime {
+    crate::no_force_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -647,6 +687,7 @@ impl CheckTimestep {
 }
 
 impl Fix for CheckTimestep {
+    crate::no_force_hooks!();
     fn id(&self) -> &str {
         &self.id
     }

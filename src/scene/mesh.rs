@@ -52,6 +52,7 @@ pub struct MeshSurfaceFix {
 }
 
 impl Fix for MeshSurfaceFix {
+    crate::no_force_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -259,6 +260,7 @@ pub struct MoveMeshFix {
 }
 
 impl Fix for MoveMeshFix {
+    crate::no_force_hooks!();
     fn id(&self) -> &str {
         &self.id
     }

@@ -252,6 +252,7 @@ pub struct RestartWriter {
 }
 
 impl Fix for RestartWriter {
+    crate::no_force_hooks!();
     fn id(&self) -> &str {
         "__restart"
     }
