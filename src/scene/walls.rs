@@ -6,7 +6,7 @@
 use super::args::Args;
 use super::model::{self, NormalSpec, PairSpec, TangentialSpec};
 use super::Session;
-use crate::engine::fix::Fix;
+use crate::engine::fix::{Chunk, Fix, Hook, Local, Stage};
 use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
@@ -17,18 +17,132 @@ use crate::physics::{Contact, V3};
 use crate::script::{Command, Variables, Word};
 use crate::engine::integrate::CHUNK;
 use rayon::prelude::*;
+use std::sync::Arc;
+
+/// What the wall's contact with one particle needs of the wall: shared by
+/// the fix and the stage it hands to the step's fused tail.
+#[derive(Clone)]
+struct WallLaws {
+    group: u32,
+    wall: PrimitiveWall,
+    kernel: Arc<dyn ContactKernel>,
+    table: Arc<ParamTable>,
+    /// Wall type (LIGGGHTS `primitive type T`); LAMMPS walls use row 1.
+    wall_type: u32,
+    width: usize,
+    /// LAMMPS `zcylinder` radius: R* includes the wall's curvature.
+    cyl_radius: Option<f64>,
+    /// JKR normal law: contacts last beyond touching.
+    jkr: bool,
+}
+
+/// Where the wall is at this step and how far history advances.
+#[derive(Clone, Copy)]
+struct WallFrame {
+    shift: f64,
+    vwall: V3,
+    dt: f64,
+}
+
+/// One particle as the wall's contact reads it.
+struct Sphere {
+    x: V3,
+    v: V3,
+    omega: V3,
+    radius: f64,
+    mass: f64,
+    kind: u32,
+    mask: u32,
+}
+
+impl WallLaws {
+    /// The wall's contact with particle `s`, added to its force `fi` and
+    /// torque `ti`; with `margin`, whether it is within reach + margin of
+    /// the wall.
+    #[inline(always)]
+    fn touch(&self, fr: &WallFrame, s: &Sphere, fi: &mut V3, ti: &mut V3, hist: &mut [f64], margin: Option<f64>) -> bool {
+        if s.mask & self.group == 0 {
+            return false;
+        }
+        let ri = s.radius;
+        let pp = self.table.get(s.kind, self.wall_type);
+        // a JKR contact lives on to the pull-off overlap (< 0): look that
+        // far; LAMMPS's zcylinder finds no contact once the sphere is
+        // off the wall (its `delr > radius` test)
+        let reach = if self.jkr && self.cyl_radius.is_none() { -jkr_pulloff_overlap(ri, pp.y_eff, pp.cohesion) } else { 0.0 };
+        let near = margin.is_some_and(|m| self.wall.contact(s.x, ri + reach + m, fr.shift).is_some());
+        let Some((delta, n, _pt)) = self.wall.contact(s.x, ri + reach, fr.shift) else {
+            clear(hist);
+            return near;
+        };
+        let delta = delta - reach;
+        if delta <= 0.0 && !self.jkr {
+            clear(hist);
+            return near;
+        }
+        // LAMMPS zcylinder: the wall's curvature enters R* through
+        // rwall = -2 R_c (met from inside) or +2 R_c (outside)
+        let r_eff = match self.cyl_radius {
+            Some(rc) => {
+                let rho = (s.x.x * s.x.x + s.x.y * s.x.y).sqrt();
+                let rwall = if rho < rc { -2.0 * rc } else { 2.0 * rc };
+                ri * rwall / (ri + rwall)
+            }
+            None => ri,
+        };
+        let mi = s.mass;
+        let vr = s.v - fr.vwall;
+        let c = Contact {
+            n,
+            r: ri - delta,
+            delta,
+            ri,
+            rj: f64::INFINITY,
+            r_eff,
+            mi,
+            mj: f64::INFINITY,
+            m_eff: mi,
+            vr,
+            vn: vr.dot(&n),
+            wi: s.omega,
+            wj: V3::zeros(),
+            dt: fr.dt,
+        };
+        let out = self.kernel.contact(&c, pp, &mut hist[..self.width]);
+        *fi += out.force_i(&c);
+        *ti += out.torque_i;
+        true
+    }
+}
+
+/// The wall's post_force in the step's fused tail: its candidates that fall
+/// in each chunk (see `WallGran::post_force`).
+struct WallStage {
+    laws: WallLaws,
+    frame: WallFrame,
+    candidates: Arc<Vec<u32>>,
+    /// The history column.
+    col: usize,
+}
+
+impl Stage for WallStage {
+    fn apply(&self, c: &mut Chunk<'_>) {
+        let (lo, hi) = (c.lo as u32, (c.lo + c.f.len()) as u32);
+        let cands = &self.candidates[self.candidates.partition_point(|&i| i < lo)..];
+        let w = self.laws.width.max(1);
+        for &i in cands.iter().take_while(|&&i| i < hi) {
+            let (i, q) = (i as usize, (i - lo) as usize);
+            let s = Sphere { x: c.x[i], v: c.v[q], omega: c.omega[q], radius: c.radius[i], mass: c.mass[i], kind: c.kind[i], mask: c.mask[i] };
+            self.laws.touch(&self.frame, &s, &mut c.f[q], &mut c.torque[q], &mut c.extra[self.col][q * w..(q + 1) * w], None);
+        }
+    }
+}
 
 /// A granular wall of primitive shape.
 pub struct WallGran {
     id: String,
-    group: u32,
-    wall: PrimitiveWall,
+    laws: WallLaws,
     motion: WallMotion,
-    kernel: Box<dyn ContactKernel>,
-    table: ParamTable,
-    /// Wall type (LIGGGHTS `primitive type T`); LAMMPS walls use row 1.
-    wall_type: u32,
-    width: usize,
     hist_name: String,
     summary: String,
     /// Time the wall motion started.
@@ -36,13 +150,9 @@ pub struct WallGran {
     /// The next post_force is the setup force evaluation: history does not
     /// advance (LAMMPS/LIGGGHTS `update->setupflag`).
     in_setup: bool,
-    /// LAMMPS `zcylinder` radius: R* includes the wall's curvature.
-    cyl_radius: Option<f64>,
-    /// JKR normal law: contacts last beyond touching.
-    jkr: bool,
     /// Particles within reach + skin of the wall at pair-list build
     /// `candidates_at`, in increasing index (see `post_force`).
-    candidates: Vec<u32>,
+    candidates: Arc<Vec<u32>>,
     candidates_at: Option<u64>,
 }
 
@@ -55,6 +165,31 @@ fn clear(hist: &mut [f64]) {
     }
 }
 
+impl WallGran {
+    /// The wall at this step; consumes the setup flag.
+    fn frame(&mut self, sim: &Sim) -> WallFrame {
+        let t = sim.time - self.t0;
+        let shift = self.motion.shift(self.laws.wall.axis(), t);
+        let vwall = self.motion.velocity(t);
+        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
+        WallFrame { shift, vwall, dt }
+    }
+
+    /// Between pair-list builds no particle moves more than half the skin
+    /// when every step checks for a build (delay 0, every 1, check yes):
+    /// then a static wall needs only the particles within reach + skin of it
+    /// at the last build, and the others have no contact and zero history.
+    /// Otherwise (moving wall, delayed checks) every particle is tried every
+    /// step. Whether the list is bounded so, and whether the candidates are
+    /// those of the current build.
+    fn bounded(&self, sim: &Sim) -> (bool, bool) {
+        let ns = &sim.neigh;
+        let built = sim.pairs.x_built.len() == sim.particles.len();
+        let bounded = built && matches!(self.motion, WallMotion::None) && ns.check && ns.delay == 0 && ns.every <= 1;
+        (bounded, bounded && self.candidates_at == Some(sim.pairs.builds))
+    }
+}
+
 impl Fix for WallGran {
     fn id(&self) -> &str {
         &self.id
@@ -63,121 +198,52 @@ impl Fix for WallGran {
         "wall/gran"
     }
     fn setup(&mut self, sim: &mut Sim) -> Result<()> {
-        sim.particles.add_extra(&self.hist_name, vec![0.0; self.width.max(1)]);
+        sim.particles.add_extra(&self.hist_name, vec![0.0; self.laws.width.max(1)]);
         self.in_setup = true;
         Ok(())
     }
+    fn local(&mut self, hook: Hook, sim: &Sim, _vars: &Variables) -> Result<Local> {
+        if hook == Hook::FinalIntegrate {
+            return Ok(Local::Nothing);
+        }
+        let (Some(col), (_, true)) = (sim.particles.extra_index(&self.hist_name), self.bounded(sim)) else {
+            return Ok(Local::Whole);
+        };
+        let frame = self.frame(sim);
+        Ok(Local::Stage(Box::new(WallStage { laws: self.laws.clone(), frame, candidates: self.candidates.clone(), col })))
+    }
     fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
-        let col = sim.particles.add_extra(&self.hist_name, vec![0.0; self.width.max(1)]);
-        let t = sim.time - self.t0;
-        let axis = self.wall.axis();
-        let shift = self.motion.shift(axis, t);
-        let vwall = self.motion.velocity(t);
-        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
-        // Between pair-list builds no particle moves more than half the skin
-        // when every step checks for a build (delay 0, every 1, check yes):
-        // then a static wall needs only the particles within reach + skin of
-        // it at the last build, and the others have no contact and zero
-        // history. Otherwise (moving wall, delayed checks) every particle is
-        // tried every step.
-        let ns = &sim.neigh;
-        let built = sim.pairs.x_built.len() == sim.particles.len();
-        let bounded = built && matches!(self.motion, WallMotion::None) && ns.check && ns.delay == 0 && ns.every <= 1;
+        let col = sim.particles.add_extra(&self.hist_name, vec![0.0; self.laws.width.max(1)]);
+        let fr = self.frame(sim);
+        let (bounded, reuse) = self.bounded(sim);
         let build = sim.pairs.builds;
-        let reuse = bounded && self.candidates_at == Some(build);
-        let margin = bounded.then_some(ns.skin);
-        let this = &*self;
-        let (group, width, w) = (this.group, this.width, this.width.max(1));
-        let crate::engine::particles::Particles {
-            x,
-            v,
-            omega,
-            f,
-            torque,
-            radius,
-            mass,
-            kind,
-            mask,
-            extra,
-            ..
-        } = &mut sim.particles;
+        let margin = bounded.then_some(sim.neigh.skin);
+        let laws = &self.laws;
+        let w = laws.width.max(1);
+        let crate::engine::particles::Particles { x, v, omega, f, torque, radius, mass, kind, mask, extra, .. } = &mut sim.particles;
         let (x, v, omega, radius, mass, kind, mask) = (&*x, &*v, &*omega, &*radius, &*mass, &*kind, &*mask);
         let data = &mut extra[col].data;
-        // the wall's contact with particle i, added to its force and torque;
-        // with `margin`, whether i is within reach + margin of the wall
-        let one = |i: usize, fi: &mut V3, ti: &mut V3, hist: &mut [f64], margin: Option<f64>| -> bool {
-            if mask[i] & group == 0 {
-                return false;
-            }
-            let ri = radius[i];
-            let pp = this.table.get(kind[i], this.wall_type);
-            // a JKR contact lives on to the pull-off overlap (< 0): look that
-            // far; LAMMPS's zcylinder finds no contact once the sphere is
-            // off the wall (its `delr > radius` test)
-            let reach = if this.jkr && this.cyl_radius.is_none() { -jkr_pulloff_overlap(ri, pp.y_eff, pp.cohesion) } else { 0.0 };
-            let near = margin.is_some_and(|m| this.wall.contact(x[i], ri + reach + m, shift).is_some());
-            let Some((delta, n, _pt)) = this.wall.contact(x[i], ri + reach, shift) else {
-                clear(hist);
-                return near;
-            };
-            let delta = delta - reach;
-            if delta <= 0.0 && !this.jkr {
-                clear(hist);
-                return near;
-            }
-            // LAMMPS zcylinder: the wall's curvature enters R* through
-            // rwall = -2 R_c (met from inside) or +2 R_c (outside)
-            let r_eff = match this.cyl_radius {
-                Some(rc) => {
-                    let rho = (x[i].x * x[i].x + x[i].y * x[i].y).sqrt();
-                    let rwall = if rho < rc { -2.0 * rc } else { 2.0 * rc };
-                    ri * rwall / (ri + rwall)
-                }
-                None => ri,
-            };
-            let mi = mass[i];
-            let vr = v[i] - vwall;
-            let c = Contact {
-                n,
-                r: ri - delta,
-                delta,
-                ri,
-                rj: f64::INFINITY,
-                r_eff,
-                mi,
-                mj: f64::INFINITY,
-                m_eff: mi,
-                vr,
-                vn: vr.dot(&n),
-                wi: omega[i],
-                wj: V3::zeros(),
-                dt,
-            };
-            let out = this.kernel.contact(&c, pp, &mut hist[..width]);
-            *fi += out.force_i(&c);
-            *ti += out.torque_i;
-            true
-        };
+        let sphere = |i: usize| Sphere { x: x[i], v: v[i], omega: omega[i], radius: radius[i], mass: mass[i], kind: kind[i], mask: mask[i] };
         if reuse {
             // the candidates in fixed chunks, each with the slices of the
             // particles from its first candidate to the next chunk's
-            let cands = &this.candidates;
+            let cands = &self.candidates;
             let n = f.len();
             let cuts: Vec<usize> = (0..cands.len().div_ceil(CHUNK)).map(|c| cands[c * CHUNK] as usize).chain([n]).collect();
             let mut jobs = Vec::with_capacity(cuts.len());
-            let (mut fr, mut tr, mut hr) = (&mut f[cuts[0]..], &mut torque[cuts[0]..], &mut data[cuts[0] * w..]);
+            let (mut fr_, mut tr, mut hr) = (&mut f[cuts[0]..], &mut torque[cuts[0]..], &mut data[cuts[0] * w..]);
             for (c, win) in cuts.windows(2).enumerate() {
                 let len = win[1] - win[0];
-                let (fc, fnext) = std::mem::take(&mut fr).split_at_mut(len);
+                let (fc, fnext) = std::mem::take(&mut fr_).split_at_mut(len);
                 let (tc, tnext) = std::mem::take(&mut tr).split_at_mut(len);
                 let (hc, hnext) = std::mem::take(&mut hr).split_at_mut(len * w);
-                (fr, tr, hr) = (fnext, tnext, hnext);
+                (fr_, tr, hr) = (fnext, tnext, hnext);
                 jobs.push((&cands[c * CHUNK..((c + 1) * CHUNK).min(cands.len())], win[0], fc, tc, hc));
             }
             let run = |(cs, lo, fc, tc, hc): (&[u32], usize, &mut [V3], &mut [V3], &mut [f64])| {
                 for &i in cs {
                     let q = i as usize - lo;
-                    one(i as usize, &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], None);
+                    laws.touch(&fr, &sphere(i as usize), &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], None);
                 }
             };
             if jobs.len() > 1 {
@@ -194,7 +260,7 @@ impl Fix for WallGran {
             let mut near = vec![];
             for q in 0..fc.len() {
                 let i = c * CHUNK + q;
-                if one(i, &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], margin) {
+                if laws.touch(&fr, &sphere(i), &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], margin) {
                     near.push(i as u32);
                 }
             }
@@ -206,7 +272,7 @@ impl Fix for WallGran {
             f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * w)).enumerate().map(body).collect()
         };
         if bounded {
-            self.candidates = near.concat();
+            self.candidates = Arc::new(near.concat());
             self.candidates_at = Some(build);
         } else {
             self.candidates_at = None;
@@ -217,12 +283,12 @@ impl Fix for WallGran {
         self.summary.clone()
     }
     fn max_surface_overlap(&self, sim: &Sim) -> Option<(usize, f64)> {
-        crate::engine::fix::deepest_overlap(sim, self.group, |i| self.surface_overlap(sim, i))
+        crate::engine::fix::deepest_overlap(sim, self.laws.group, |i| self.surface_overlap(sim, i))
     }
     fn surface_overlap(&self, sim: &Sim, i: usize) -> Option<f64> {
-        let shift = self.motion.shift(self.wall.axis(), sim.time - self.t0);
+        let shift = self.motion.shift(self.laws.wall.axis(), sim.time - self.t0);
         let p = &sim.particles;
-        self.wall.contact(p.x[i], p.radius[i], shift).map(|c| c.0).filter(|d| *d > 0.0)
+        self.laws.wall.contact(p.x[i], p.radius[i], shift).map(|c| c.0).filter(|d| *d > 0.0)
     }
 }
 
@@ -364,21 +430,14 @@ fn add_wall(s: &mut Session, id: &str, group: u32, spec: PairSpec, table: ParamT
     };
     let jkr = matches!(spec.normal, NormalSpec::GranularCohesive(model::CohesiveNormal::Jkr, _));
     s.add_fix(Box::new(WallGran {
-        cyl_radius,
-        jkr,
+        laws: WallLaws { cyl_radius, jkr, group, wall, kernel: Arc::from(kernel), table: Arc::new(table), wall_type, width },
         id: id.to_string(),
-        group,
-        wall,
         motion,
-        kernel,
-        table,
-        wall_type,
-        width,
         hist_name: format!("wall_history:{id}"),
         summary,
         t0,
         in_setup: false,
-        candidates: vec![],
+        candidates: Arc::new(vec![]),
         candidates_at: None,
     }))
 }
