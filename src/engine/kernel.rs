@@ -276,8 +276,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         if pairs.live.len() != m {
             pairs.live = vec![1; m];
         }
-        let PairList { a, b, image, images, hist, live, block_start, block_cross, cslot, .. } = pairs;
-        let (a, b, image, images, block_start, cslot) = (&a[..], &b[..], &image[..], &images[..], &block_start[..], &cslot[..]);
+        let PairList { a, b, image, images, hist, live, block_start, block_cross, .. } = pairs;
+        let (a, b, image, images, block_start) = (&a[..], &b[..], &image[..], &images[..], &block_start[..]);
         // split the pairs' history and deferred slots at the block ranges
         let nblocks = block_start.len().saturating_sub(1);
         let mut jobs = Vec::with_capacity(nblocks);
@@ -305,7 +305,9 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         let block = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
             let lo = q * bs;
             let ps = block_start[q] as usize;
-            let base = block_cross[q] as usize;
+            // the block's cross pairs have consecutive slots in pair order
+            // (`PairList::index`): a count gives them
+            let mut slot = 0;
             d.fill([V3::zeros(); 2]);
             f.fill(V3::zeros());
             tq.fill(V3::zeros());
@@ -313,7 +315,9 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             for k in ps..block_start[q + 1] as usize {
                 let i = a[k] as usize;
                 let j = b[k] as usize;
-                let own_j = j >= lo && j - lo < f.len();
+                let own_j = j.wrapping_sub(lo) < f.len();
+                let js = slot;
+                slot += !own_j as usize;
                 lv[k - ps] = 1;
                 let hk = &mut h[(k - ps) * w..(k - ps + 1) * w];
                 let xj = p.x[j] + images[image[k] as usize];
@@ -343,7 +347,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                     f[j - lo] -= fi;
                     tq[j - lo] += o.torque_j;
                 } else {
-                    d[cslot[k] as usize - base] = [fi, o.torque_j];
+                    d[js] = [fi, o.torque_j];
                 }
             }
             virial
@@ -353,7 +357,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             d.fill([V3::zeros(); 2]);
             f.fill(V3::zeros());
             tq.fill(V3::zeros());
-            let blk = Block { p, a, b, image, images, cslot, base: block_cross[q] as usize, table, dt, lo: q * bs, ps, pe };
+            let blk = Block { p, a, b, image, images, table, dt, lo: q * bs, ps, pe };
             self.block_batched(&blk, h, d, lv, f, tq)
         };
         let virials: Vec<f64> = match (Self::BATCHED && !self.scalar_only(), nblocks > 1) {
@@ -385,9 +389,6 @@ struct Block<'a> {
     b: &'a [u32],
     image: &'a [u8],
     images: &'a [V3],
-    /// Deferred slot per pair, and the block's first slot.
-    cslot: &'a [u32],
-    base: usize,
     table: &'a ParamTable,
     dt: f64,
     /// First particle of the block.
@@ -426,6 +427,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let p = k.p;
         let w = Self::WIDTH;
         let mut queue = [0usize; LANES];
+        // each queued pair's deferred slot (used when b is outside the
+        // block): the block's cross pairs have consecutive slots in pair
+        // order (`PairList::index`), so a count gives them
+        let mut slots = [0usize; LANES];
+        let mut slot = 0;
+        let (lo, len) = (k.lo, f.len());
         let mut queued = 0;
         let mut virial = 0.0;
         // non-contact cohesion reaches beyond touching, by the pair's
@@ -448,17 +455,19 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             let apart = r2 >= reach * reach;
             let touch = !apart & (r2 != 0.0);
             queue[queued] = k.ps + q;
+            slots[queued] = slot;
+            slot += (j.wrapping_sub(lo) >= len) as usize;
             queued += touch as usize;
             // the flag's previous state moves to bit 2; pairs that came apart
             // are cleared after the walk (rare; a branch here would not be)
             lv[q] = ((lv[q] & 1) << 2) | (!apart) as u8;
             if queued == LANES {
-                self.run_batch(k, &queue, LANES, h, d, lv, f, tq, &mut virial);
+                self.run_batch(k, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
                 queued = 0;
             }
         }
         if queued > 0 {
-            self.run_batch(k, &queue, queued, h, d, lv, f, tq, &mut virial);
+            self.run_batch(k, &queue, &slots, queued, h, d, lv, f, tq, &mut virial);
         }
         for (q, l) in lv.iter_mut().enumerate() {
             if *l & (WAS_LIVE | 1) == WAS_LIVE {
@@ -478,6 +487,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         &self,
         k: &Block<'_>,
         queue: &[usize; LANES],
+        slots: &[usize; LANES],
         count: usize,
         h: &mut [f64],
         d: &mut [[V3; 2]],
@@ -547,11 +557,11 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             *virial += vir.0[l];
             f[i - k.lo] += fl;
             tq[i - k.lo] += o.torque_i.lane(l);
-            if j >= k.lo && j - k.lo < f.len() {
+            if j.wrapping_sub(k.lo) < f.len() {
                 f[j - k.lo] -= fl;
                 tq[j - k.lo] += o.torque_j.lane(l);
             } else {
-                d[k.cslot[pk] as usize - k.base] = [fl, o.torque_j.lane(l)];
+                d[slots[l]] = [fl, o.torque_j.lane(l)];
             }
         }
     }
@@ -566,7 +576,7 @@ pub struct Forces<'a> {
     pub f: &'a mut [V3],
     /// Torque per particle.
     pub torque: &'a mut [V3],
-    /// Per cross pair (`PairList::cslot`): force on `a` and torque on `b`,
+    /// Per cross pair (slots in pair order, see `PairList::cross`): force on `a` and torque on `b`,
     /// zero when the pair is apart.
     pub defer: &'a mut Vec<[V3; 2]>,
 }

@@ -86,9 +86,6 @@ pub struct PairList {
     /// and `a` lies in another block, in increasing pair index: their share
     /// is added after the block pass.
     pub cross: Vec<u32>,
-    /// Per pair: its deferred slot if `a` and `b` lie in different blocks
-    /// (slots count those pairs in pair order), else `u32::MAX`.
-    pub cslot: Vec<u32>,
     /// Slot where each block's cross pairs start (blocks + 1 entries).
     pub block_cross: Vec<u32>,
 }
@@ -471,8 +468,9 @@ impl PairList {
         }
         // cross pairs get consecutive slots in pair order (so each block's
         // slots are a range), and each particle lists the slots where it is b
-        self.cslot.clear();
-        self.cslot.resize(m, u32::MAX);
+        // (the force pass counts the slots in the same order, so the pairs
+        // do not keep them)
+        let mut cslot = vec![u32::MAX; m];
         self.block_cross = vec![0; nblocks + 1];
         let mut ccount = vec![0u32; n + 1];
         let mut slots = 0u32;
@@ -480,7 +478,7 @@ impl PairList {
             let (a, b) = (self.a[k] as usize, self.b[k] as usize);
             if a / bs != b / bs {
                 ccount[b + 1] += 1;
-                self.cslot[k] = slots;
+                cslot[k] = slots;
                 slots += 1;
                 self.block_cross[a / bs + 1] += 1;
             }
@@ -495,8 +493,8 @@ impl PairList {
         self.cross = vec![0; ccount[n] as usize];
         for k in 0..m {
             let b = self.b[k] as usize;
-            if self.cslot[k] != u32::MAX {
-                self.cross[fill[b] as usize] = self.cslot[k];
+            if cslot[k] != u32::MAX {
+                self.cross[fill[b] as usize] = cslot[k];
                 fill[b] += 1;
             }
         }
