@@ -1,6 +1,8 @@
-//! The step's tail (the cross-block shares of the pair forces, every fix's
-//! post_force, every fix's final_integrate) runs fused, chunk by chunk, where
-//! the fixes act particle by particle. That must change no bit: a bed of
+//! The step's head (every fix's initial_integrate and the skin check of
+//! the pair list) and its tail (the cross-block shares of the pair forces,
+//! every fix's post_force, every fix's final_integrate) run fused, chunk by
+//! chunk, where the fixes act particle by particle. That must change no bit
+//! (nor any pair-list build, which would reorder sums): a bed of
 //! 3,375 overlapping spheres (more than one block of the pair pass, so pairs
 //! cross blocks) bursts apart and falls with spin onto a frictional floor
 //! with rolling resistance, under gravity, on 2 threads; the fused run and
@@ -24,7 +26,7 @@ fn data() -> String {
     }
     s += "\nVelocities\n\n";
     for i in 0..n {
-        let (vx, vy) = (0.2 * (frac(i, 0.414_214) - 0.5), 0.2 * (frac(i, 0.732_051) - 0.5));
+        let (vx, vy) = (0.5 * (frac(i, 0.414_214) - 0.5), 0.5 * (frac(i, 0.732_051) - 0.5));
         let (wx, wy, wz) = (200.0 * (frac(i, 0.317_1) - 0.5), 200.0 * (frac(i, 0.576_3) - 0.5), 50.0 * (frac(i, 0.913_7) - 0.5));
         s += &format!("{} {vx} {vy} 0 {wx} {wy} {wz}\n", i + 1);
     }
@@ -49,36 +51,42 @@ fn deck(dir: &str, gravity: &str) -> String {
     )
 }
 
-/// The dump of one run on 2 threads, fused or not.
-fn run(gravity: &str, fused: bool) -> Vec<u8> {
+/// The dump of one run on 2 threads, fused or not, and its pair-list builds.
+fn run(gravity: &str, fused: bool) -> (Vec<u8>, u64) {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path().to_str().unwrap().to_string();
     std::fs::write(dir.path().join("data.spheres"), data()).unwrap();
     std::fs::write(dir.path().join("in.spheres"), deck(&d, gravity)).unwrap();
     let args = DeckArgs { deck: dir.path().join("in.spheres"), var: vec![], perturb: None, var_groups: vec![] };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-    let go = || run_deck(&args, false, 2, None, true, None, Default::default()).2;
-    let r = pool.install(|| if fused { go() } else { with_unfused_tail(go) });
+    let go = || {
+        let (session, _, r) = run_deck(&args, false, 2, None, true, None, Default::default());
+        (r, session.sim.pairs.builds)
+    };
+    let (r, builds) = pool.install(|| if fused { go() } else { with_unfused_tail(go) });
     assert!(r.is_ok(), "demx failed: {:?}", r.err());
-    std::fs::read(dir.path().join("dump.spheres")).expect("dump written")
+    (std::fs::read(dir.path().join("dump.spheres")).expect("dump written"), builds)
 }
 
-fn same(a: &[u8], b: &[u8], what: &str) {
+fn same((a, builds_a): &(Vec<u8>, u64), (b, builds_b): &(Vec<u8>, u64), what: &str) {
+    // the skin check decides the same builds (one fused into the head)
+    assert_eq!(builds_a, builds_b, "{what}: pair-list builds differ");
+    assert!(*builds_a > 3, "{what}: only {builds_a} pair-list builds: the skin check went untested");
     if a != b {
         let at = a.iter().zip(b).position(|(x, y)| x != y).unwrap_or(a.len().min(b.len()));
         let line = a[..at].iter().filter(|&&c| c == b'\n').count() + 1;
-        panic!("{what}: the fused tail changed the dump from line {line}");
+        panic!("{what}: the fused step changed the dump from line {line}");
     }
 }
 
 #[test]
-fn fused_tail_changes_no_bit() {
+fn fused_head_and_tail_change_no_bit() {
     let gravity = "fix grav all gravity 9.81 vector 0.0 0.0 -1.0";
     let fused = run(gravity, true);
     same(&fused, &run(gravity, false), "constant gravity");
     // the spheres pushed each other apart and the bottom layer met the
     // floor: in the last frame some move up and many spin
-    let text = String::from_utf8_lossy(&fused);
+    let text = String::from_utf8_lossy(&fused.0);
     let last = text.rsplit("ITEM: ATOMS").next().unwrap();
     let rows: Vec<Vec<f64>> = last.lines().skip(1).map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect()).collect();
     assert_eq!(rows.len(), 3375);

@@ -7,10 +7,13 @@ use crate::error::Result;
 use crate::physics::V3;
 use crate::script::Variables;
 
-/// The two hooks after the pair forces that may run particle by particle,
-/// fused into one pass over the particles (see [`Fix::local`]).
+/// The hooks that may run particle by particle, fused into one pass over
+/// the particles (see [`Fix::local`]): the step's head (before the pair
+/// pass) and its tail (after it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Hook {
+    /// [`Fix::initial_integrate`] (the head).
+    InitialIntegrate,
     /// [`Fix::post_force`].
     PostForce,
     /// [`Fix::final_integrate`].
@@ -42,8 +45,8 @@ pub trait Stage: Send + Sync {
 pub struct Chunk<'a> {
     /// Index of the chunk's first particle.
     pub lo: usize,
-    /// Positions (all particles).
-    pub x: &'a [V3],
+    /// The chunk's positions.
+    pub x: &'a mut [V3],
     /// Radii (all particles).
     pub radius: &'a [f64],
     /// Masses (all particles).
@@ -163,11 +166,11 @@ pub fn deepest_overlap(sim: &Sim, group: u32, overlap: impl Fn(usize) -> Option<
     worst
 }
 
-/// [`Fix::local`] for a fix that has neither a post_force nor a
-/// final_integrate: nothing at either hook, so it does not split the step's
-/// fused tail.
+/// [`Fix::local`] for a fix that has none of initial_integrate, post_force
+/// and final_integrate: nothing at any of those hooks, so it does not split
+/// the step's fused head or tail.
 #[macro_export]
-macro_rules! no_force_hooks {
+macro_rules! no_step_hooks {
     () => {
         fn local(
             &mut self,
@@ -183,7 +186,7 @@ macro_rules! no_force_hooks {
 /// Placeholder put in a fix's slot while its hook runs.
 pub struct Hole;
 impl Fix for Hole {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         ""
     }

@@ -88,15 +88,46 @@ where
 /// First half: v += dt/2 f/m; x += dt v; omega += dt/2 torque/I.
 /// `group` is the fix's group bit; `dtf = 0.5 dt` (ftm2v = 1 in si/lj/cgs).
 pub fn initial_integrate(p: &mut Particles, group: u32, dt: f64) {
-    let dtf = 0.5 * dt;
-    let dtfrot = dtf / INERTIA;
-    each_in_group(p, group, |h, i, x, v, w| {
-        let dtfm = dtf / h.mass[i];
-        *v += h.f[i] * dtfm;
+    let s = InitialHalf { group, dt, rotate: true };
+    each_in_group(p, group, |h, i, x, v, w| s.one(h.f[i], h.torque[i], h.mass[i], h.radius[i], x, v, w));
+}
+
+/// The first half of `fix nve/sphere` (`rotate`) or `fix nve`, particle by
+/// particle: the form the step's fused head runs (a [`Stage`]).
+pub struct InitialHalf {
+    /// The fix's group bit.
+    pub group: u32,
+    /// Time step.
+    pub dt: f64,
+    /// Whether angular velocity is integrated (nve/sphere) or left (nve).
+    pub rotate: bool,
+}
+
+impl InitialHalf {
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn one(&self, f: V3, torque: V3, m: f64, r: f64, x: &mut V3, v: &mut V3, w: &mut V3) {
+        let dt = self.dt;
+        let dtf = 0.5 * dt;
+        let dtfm = dtf / m;
+        *v += f * dtfm;
         *x += *v * dt;
-        let dtirotate = dtfrot / (h.radius[i] * h.radius[i] * h.mass[i]);
-        *w += h.torque[i] * dtirotate;
-    });
+        if self.rotate {
+            let dtirotate = dtf / INERTIA / (r * r * m);
+            *w += torque * dtirotate;
+        }
+    }
+}
+
+impl Stage for InitialHalf {
+    fn apply(&self, c: &mut Chunk<'_>) {
+        for q in 0..c.v.len() {
+            let i = c.lo + q;
+            if c.mask[i] & self.group != 0 {
+                self.one(c.f[q], c.torque[q], c.mass[i], c.radius[i], &mut c.x[q], &mut c.v[q], &mut c.omega[q]);
+            }
+        }
+    }
 }
 
 /// Second half: v += dt/2 f/m; omega += dt/2 torque/I.
@@ -143,12 +174,8 @@ impl Stage for FinalHalf {
 /// `fix nve` first half: translation only (LAMMPS `FixNVE`); angular
 /// velocity is left alone, so particles integrated this way do not rotate.
 pub fn initial_integrate_nve(p: &mut Particles, group: u32, dt: f64) {
-    let dtf = 0.5 * dt;
-    each_in_group(p, group, |h, i, x, v, _w| {
-        let dtfm = dtf / h.mass[i];
-        *v += h.f[i] * dtfm;
-        *x += *v * dt;
-    });
+    let s = InitialHalf { group, dt, rotate: false };
+    each_in_group(p, group, |h, i, x, v, w| s.one(h.f[i], h.torque[i], h.mass[i], h.radius[i], x, v, w));
 }
 
 /// `fix nve` second half.

@@ -282,25 +282,58 @@ impl PairList {
 
     /// Whether a rebuild is due at `step` (LAMMPS `Neighbor::decide`).
     pub fn needs_rebuild(&mut self, p: &Particles, s: &NeighSettings, step: i64) -> bool {
-        if self.x_built.len() != p.len() {
-            return true;
+        match self.due(p.len(), s, step) {
+            Due::Build => true,
+            Due::Skip => false,
+            Due::Check => {
+                let moved = self.moved_any(&p.x, s);
+                self.checked(moved, s, step)
+            }
+        }
+    }
+
+    /// What `neigh_modify` asks of step `step` with `n` particles: a build
+    /// whatever the particles did, a check of how far they moved, or
+    /// nothing.
+    pub fn due(&self, n: usize, s: &NeighSettings, step: i64) -> Due {
+        if self.x_built.len() != n {
+            return Due::Build;
         }
         let since = step - self.last_build;
         if since < s.delay || (s.every > 0 && since % s.every != 0) {
-            return false;
+            return Due::Skip;
         }
-        if !s.check {
-            return true;
-        }
-        let lim = 0.25 * s.skin * s.skin;
-        // a yes/no over all particles: the same answer on any thread count
-        let moved_in = |x: &[V3], x0: &[V3]| x.iter().zip(x0).any(|(x, x0)| (x - x0).norm_squared() > lim);
-        let moved = if p.len() >= 2 * CHUNK {
-            use rayon::prelude::*;
-            p.x.par_chunks(CHUNK).zip(self.x_built.par_chunks(CHUNK)).any(|(x, x0)| moved_in(x, x0))
+        if s.check {
+            Due::Check
         } else {
-            moved_in(&p.x, &self.x_built)
-        };
+            Due::Build
+        }
+    }
+
+    /// Whether any particle (at `x`) moved more than half the skin since the
+    /// last build, as a pass of its own.
+    pub fn moved_any(&self, x: &[V3], s: &NeighSettings) -> bool {
+        // a yes/no over all particles: the same answer on any thread count
+        if x.len() >= 2 * CHUNK {
+            use rayon::prelude::*;
+            x.par_chunks(CHUNK).enumerate().any(|(c, x)| self.moved(x, c * CHUNK, s))
+        } else {
+            self.moved(x, 0, s)
+        }
+    }
+
+    /// Whether any of the particles `lo..lo + x.len()` (at `x`) moved more
+    /// than half the skin since the last build (LAMMPS `Neighbor::check_distance`).
+    #[inline]
+    pub fn moved(&self, x: &[V3], lo: usize, s: &NeighSettings) -> bool {
+        let lim = 0.25 * s.skin * s.skin;
+        x.iter().zip(&self.x_built[lo..lo + x.len()]).any(|(x, x0)| (x - x0).norm_squared() > lim)
+    }
+
+    /// The answer of a [`Due::Check`] at `step` once `moved` is known over all
+    /// particles: counts a dangerous build (one at the first step allowed).
+    pub fn checked(&mut self, moved: bool, s: &NeighSettings, step: i64) -> bool {
+        let since = step - self.last_build;
         if moved && since == s.delay.max(1) && s.delay > 0 {
             self.dangerous += 1;
         }
@@ -514,6 +547,17 @@ impl PairList {
     pub fn invalidate(&mut self) {
         self.x_built.clear();
     }
+}
+
+/// What a step owes the pair list ([`PairList::due`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Due {
+    /// Build it.
+    Build,
+    /// Build it if a particle moved more than half the skin.
+    Check,
+    /// Keep it.
+    Skip,
 }
 
 /// Storage order that sorts particles by the Morton (Z-order) code of their

@@ -4,7 +4,7 @@ use super::compute::Compute;
 use super::domain::Domain;
 use super::fix::{Chunk, Fix, Hole, Hook, Local, Stage};
 use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable};
-use super::neighbor::{NeighSettings, PairList};
+use super::neighbor::{Due, NeighSettings, PairList};
 use super::output::{Dump, Logger, Thermo};
 use super::particles::Particles;
 use crate::error::{Error, Result};
@@ -18,12 +18,12 @@ use std::time::Instant;
 const TAIL_CHUNK: usize = 1024;
 
 thread_local! {
-    /// Tests set it to call every hook of the tail on its own, as one pass
-    /// per hook, to check that the fused tail gives the same bits.
+    /// Tests set it to call every hook of the step's head and tail on its
+    /// own, as one pass per hook, to check that fusing gives the same bits.
     static UNFUSED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
-/// Run `f` with the step's tail unfused on this thread (tests).
+/// Run `f` with the step's head and tail unfused on this thread (tests).
 pub fn with_unfused_tail<T>(f: impl FnOnce() -> T) -> T {
     UNFUSED.with(|u| u.set(true));
     let r = f();
@@ -338,15 +338,20 @@ impl Sim {
         self.step += 1;
         self.time += self.dt;
         let t = Instant::now();
-        self.each_fix(|f, s| {
-            f.initial_integrate(s);
-            Ok(())
-        })?;
         let step = self.step;
+        let due = self.pairs.due(self.particles.len(), &self.neigh, step);
+        let moved = self.head(vars, due == Due::Check)?;
         let wanted = self.fixes.iter().any(|f| f.next_reneighbor() == Some(step));
         let tm = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        if self.force_rebuild || wanted || self.pairs.needs_rebuild(&self.particles, &self.neigh, self.step) {
+        let build = self.force_rebuild
+            || wanted
+            || match due {
+                Due::Build => true,
+                Due::Skip => false,
+                Due::Check => self.pairs.checked(moved, &self.neigh, step),
+            };
+        if build {
             self.each_fix(|f, s| f.pre_exchange(s, vars))?;
             self.rebuild()?;
         }
@@ -370,6 +375,37 @@ impl Sim {
         Ok(())
     }
 
+    /// The step's head: every fix's initial_integrate, fused chunk by chunk
+    /// where the fixes act particle by particle (as [`Sim::tail`]); with
+    /// `check`, the same pass then tells whether a particle moved more than
+    /// half the skin since the last build ([`PairList::moved`]), over the
+    /// positions after every fix's initial_integrate.
+    fn head(&mut self, vars: &Variables, check: bool) -> Result<bool> {
+        let mut stages: Vec<Box<dyn Stage>> = vec![];
+        let fuse = !UNFUSED.with(|u| u.get());
+        for k in 0..self.fixes.len() {
+            let mut fix = std::mem::replace(&mut self.fixes[k], Box::new(Hole));
+            let local = if fuse { fix.local(Hook::InitialIntegrate, self, vars) } else { Ok(Local::Whole) };
+            let local = match local {
+                Ok(Local::Whole) => {
+                    self.fused(&mut stages, false, false);
+                    fix.initial_integrate(self);
+                    Ok(Local::Nothing)
+                }
+                other => other,
+            };
+            self.fixes[k] = fix;
+            if let Local::Stage(st) = local? {
+                stages.push(st);
+            }
+        }
+        if !fuse {
+            // the check on its own, as tests compare
+            return Ok(check && self.pairs.moved_any(&self.particles.x, &self.neigh));
+        }
+        Ok(self.fused(&mut stages, false, check))
+    }
+
     /// The step after the pair pass: the cross-block shares of the pair
     /// forces, then every fix's post_force, then every fix's final_integrate,
     /// in LAMMPS order. Hooks that act particle by particle ([`Fix::local`])
@@ -388,10 +424,10 @@ impl Sim {
                 let local = if fuse { fix.local(hook, self, vars) } else { Ok(Local::Whole) };
                 let local = match local {
                     Ok(Local::Whole) => {
-                        self.fused(&mut stages, &mut gather);
+                        self.fused(&mut stages, std::mem::take(&mut gather), false);
                         match hook {
                             Hook::PostForce => fix.post_force(self, vars).map(|_| Local::Nothing),
-                            Hook::FinalIntegrate => {
+                            _ => {
                                 fix.final_integrate(self);
                                 Ok(Local::Nothing)
                             }
@@ -405,30 +441,32 @@ impl Sim {
                 }
             }
         }
-        self.fused(&mut stages, &mut gather);
+        self.fused(&mut stages, gather, false);
         Ok(())
     }
 
-    /// Run the pending cross pass (when `gather`) and `stages` over the
-    /// particles in fixed chunks, in parallel from two chunks up; empties both.
-    fn fused(&mut self, stages: &mut Vec<Box<dyn Stage>>, gather: &mut bool) {
-        if stages.is_empty() && !*gather {
-            return;
+    /// Run the cross pass (when `gather`), then `stages`, then the skin check
+    /// (when `check`; its answer is returned) over the particles in fixed
+    /// chunks, in parallel from two chunks up; empties `stages`.
+    fn fused(&mut self, stages: &mut Vec<Box<dyn Stage>>, gather: bool, check: bool) -> bool {
+        if stages.is_empty() && !gather && !check {
+            return false;
         }
-        let cross = std::mem::take(gather) && !self.pairs.cross.is_empty();
-        let (pairs, defer) = (&self.pairs, &self.pair_defer[..]);
+        let cross = gather && !self.pairs.cross.is_empty();
+        let (pairs, defer, neigh) = (&self.pairs, &self.pair_defer[..], &self.neigh);
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, .. } = &mut self.particles;
         let n = x.len();
-        let (x, radius, mass, kind, mask) = (&x[..], &radius[..], &mass[..], &kind[..], &mask[..]);
+        let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
         // each extra column cut at the chunks
         let mut cols: Vec<std::slice::ChunksMut<'_, f64>> = extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(TAIL_CHUNK * e.width.max(1))).collect();
-        let jobs: Vec<Chunk<'_>> = v
+        let jobs: Vec<Chunk<'_>> = x
             .chunks_mut(TAIL_CHUNK)
+            .zip(v.chunks_mut(TAIL_CHUNK))
             .zip(omega.chunks_mut(TAIL_CHUNK))
             .zip(f.chunks_mut(TAIL_CHUNK))
             .zip(torque.chunks_mut(TAIL_CHUNK))
             .enumerate()
-            .map(|(c, (((v, omega), f), torque))| Chunk {
+            .map(|(c, ((((x, v), omega), f), torque))| Chunk {
                 lo: c * TAIL_CHUNK,
                 x,
                 radius,
@@ -443,21 +481,24 @@ impl Sim {
             })
             .collect();
         let pending = &*stages;
-        let run = |mut c: Chunk<'_>| {
+        let run = |mut c: Chunk<'_>| -> bool {
             if cross {
                 cross_gather_chunk(pairs, defer, c.lo, c.f, c.torque);
             }
             for st in pending {
                 st.apply(&mut c);
             }
+            check && pairs.moved(c.x, c.lo, neigh)
         };
-        if jobs.len() > 1 {
+        // a yes/no over the chunks: the same on any thread count
+        let moved = if jobs.len() > 1 {
             use rayon::prelude::*;
-            jobs.into_par_iter().for_each(run);
+            jobs.into_par_iter().map(run).reduce(|| false, |a, b| a | b)
         } else {
-            jobs.into_iter().for_each(run);
-        }
+            jobs.into_iter().fold(false, |a, c| a | run(c))
+        };
         stages.clear();
+        moved
     }
 
     /// Thermo and dumps due at this step.

@@ -32,6 +32,7 @@ impl Fix for NveSphere {
     }
     fn local(&mut self, hook: Hook, sim: &Sim, _vars: &Variables) -> Result<Local> {
         Ok(match hook {
+            Hook::InitialIntegrate => Local::Stage(Box::new(integrate::InitialHalf { group: self.group, dt: sim.dt, rotate: true })),
             Hook::PostForce => Local::Nothing,
             Hook::FinalIntegrate => Local::Stage(Box::new(integrate::FinalHalf { group: self.group, dt: sim.dt, rotate: true })),
         })
@@ -64,6 +65,7 @@ impl Fix for Nve {
     }
     fn local(&mut self, hook: Hook, sim: &Sim, _vars: &Variables) -> Result<Local> {
         Ok(match hook {
+            Hook::InitialIntegrate => Local::Stage(Box::new(integrate::InitialHalf { group: self.group, dt: sim.dt, rotate: false })),
             Hook::PostForce => Local::Nothing,
             Hook::FinalIntegrate => Local::Stage(Box::new(integrate::FinalHalf { group: self.group, dt: sim.dt, rotate: false })),
         })
@@ -140,7 +142,7 @@ impl Fix for Gravity {
         Ok(match (hook, &self.magnitude) {
             (Hook::PostForce, Magnitude::Const(_)) => Local::Stage(Box::new(Pull { acc: self.acc, group: self.group })),
             (Hook::PostForce, Magnitude::Var(_)) => Local::Whole,
-            (Hook::FinalIntegrate, _) => Local::Nothing,
+            (Hook::InitialIntegrate | Hook::FinalIntegrate, _) => Local::Nothing,
         })
     }
     fn summary(&self) -> String {
@@ -357,7 +359,7 @@ pub struct Print {
 }
 
 impl Fix for Print {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -523,7 +525,7 @@ impl AveTime {
 }
 
 impl Fix for AveTime {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -687,7 +689,7 @@ impl CheckTimestep {
 }
 
 impl Fix for CheckTimestep {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }

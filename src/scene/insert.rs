@@ -197,7 +197,7 @@ impl Adapt {
 }
 
 impl Fix for Adapt {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -274,7 +274,7 @@ impl Template {
 }
 
 impl Fix for Template {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -443,7 +443,7 @@ impl Distribution {
 }
 
 impl Fix for Distribution {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -1407,7 +1407,7 @@ impl LiggghtsInsert {
 }
 
 impl Fix for LiggghtsInsert {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -1977,7 +1977,7 @@ fn parse_pour(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args
 }
 
 impl Fix for Pour {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }

@@ -12,7 +12,7 @@
 use super::args::{self, Args};
 use super::model::{self, NormalSpec, PairSpec, TangentialSpec};
 use super::Session;
-use crate::engine::fix::Fix;
+use crate::engine::fix::{Fix, Hook, Local};
 use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::mesh_surface::{resolve_particle, SharedMesh, Slots, SurfaceMesh, DEFAULT_CURVATURE_COS, MESH_SLOTS};
 use crate::engine::output::Dump;
@@ -52,7 +52,7 @@ pub struct MeshSurfaceFix {
 }
 
 impl Fix for MeshSurfaceFix {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -260,7 +260,10 @@ pub struct MoveMeshFix {
 }
 
 impl Fix for MoveMeshFix {
-    crate::no_force_hooks!();
+    fn local(&mut self, hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
+        // the mesh's clock advances in initial_integrate
+        Ok(if hook == Hook::InitialIntegrate { Local::Whole } else { Local::Nothing })
+    }
     fn id(&self) -> &str {
         &self.id
     }

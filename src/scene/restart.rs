@@ -252,7 +252,7 @@ pub struct RestartWriter {
 }
 
 impl Fix for RestartWriter {
-    crate::no_force_hooks!();
+    crate::no_step_hooks!();
     fn id(&self) -> &str {
         "__restart"
     }

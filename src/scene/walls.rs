@@ -132,7 +132,7 @@ impl Stage for WallStage {
         let w = self.laws.width.max(1);
         for &i in cands.iter().take_while(|&&i| i < hi) {
             let (i, q) = (i as usize, (i - lo) as usize);
-            let s = Sphere { x: c.x[i], v: c.v[q], omega: c.omega[q], radius: c.radius[i], mass: c.mass[i], kind: c.kind[i], mask: c.mask[i] };
+            let s = Sphere { x: c.x[q], v: c.v[q], omega: c.omega[q], radius: c.radius[i], mass: c.mass[i], kind: c.kind[i], mask: c.mask[i] };
             self.laws.touch(&self.frame, &s, &mut c.f[q], &mut c.torque[q], &mut c.extra[self.col][q * w..(q + 1) * w], None);
         }
     }
@@ -203,7 +203,7 @@ impl Fix for WallGran {
         Ok(())
     }
     fn local(&mut self, hook: Hook, sim: &Sim, _vars: &Variables) -> Result<Local> {
-        if hook == Hook::FinalIntegrate {
+        if hook != Hook::PostForce {
             return Ok(Local::Nothing);
         }
         let (Some(col), (_, true)) = (sim.particles.extra_index(&self.hist_name), self.bounded(sim)) else {
