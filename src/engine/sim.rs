@@ -381,25 +381,8 @@ impl Sim {
     /// half the skin since the last build ([`PairList::moved`]), over the
     /// positions after every fix's initial_integrate.
     fn head(&mut self, vars: &Variables, check: bool) -> Result<bool> {
-        let mut stages: Vec<Box<dyn Stage>> = vec![];
-        let fuse = !UNFUSED.with(|u| u.get());
-        for k in 0..self.fixes.len() {
-            let mut fix = std::mem::replace(&mut self.fixes[k], Box::new(Hole));
-            let local = if fuse { fix.local(Hook::InitialIntegrate, self, vars) } else { Ok(Local::Whole) };
-            let local = match local {
-                Ok(Local::Whole) => {
-                    self.fused(&mut stages, false, false);
-                    fix.initial_integrate(self);
-                    Ok(Local::Nothing)
-                }
-                other => other,
-            };
-            self.fixes[k] = fix;
-            if let Local::Stage(st) = local? {
-                stages.push(st);
-            }
-        }
-        if !fuse {
+        let mut stages = self.hooks(&[Hook::InitialIntegrate], vars, &mut false)?;
+        if UNFUSED.with(|u| u.get()) {
             // the check on its own, as tests compare
             return Ok(check && self.pairs.moved_any(&self.particles.x, &self.neigh));
         }
@@ -415,19 +398,32 @@ impl Sim {
     /// pass per hook. A hook that needs the whole simulation ends the fused
     /// run before it and is called as it is.
     fn tail(&mut self, vars: &Variables) -> Result<()> {
-        let mut stages: Vec<Box<dyn Stage>> = vec![];
         let mut gather = true;
+        let mut stages = self.hooks(&[Hook::PostForce, Hook::FinalIntegrate], vars, &mut gather)?;
+        self.fused(&mut stages, gather, false);
+        Ok(())
+    }
+
+    /// Every fix's `hooks`, in order: a fix's stage joins the pending ones,
+    /// a whole hook first runs the pending stages (and the cross pass, while
+    /// `gather`) and is then called. Returns the stages still pending.
+    fn hooks(&mut self, hooks: &[Hook], vars: &Variables, gather: &mut bool) -> Result<Vec<Box<dyn Stage>>> {
+        let mut stages: Vec<Box<dyn Stage>> = vec![];
         let fuse = !UNFUSED.with(|u| u.get());
-        for hook in [Hook::PostForce, Hook::FinalIntegrate] {
+        for &hook in hooks {
             for k in 0..self.fixes.len() {
                 let mut fix = std::mem::replace(&mut self.fixes[k], Box::new(Hole));
                 let local = if fuse { fix.local(hook, self, vars) } else { Ok(Local::Whole) };
                 let local = match local {
                     Ok(Local::Whole) => {
-                        self.fused(&mut stages, std::mem::take(&mut gather), false);
+                        self.fused(&mut stages, std::mem::take(gather), false);
                         match hook {
                             Hook::PostForce => fix.post_force(self, vars).map(|_| Local::Nothing),
-                            _ => {
+                            Hook::InitialIntegrate => {
+                                fix.initial_integrate(self);
+                                Ok(Local::Nothing)
+                            }
+                            Hook::FinalIntegrate => {
                                 fix.final_integrate(self);
                                 Ok(Local::Nothing)
                             }
@@ -441,8 +437,7 @@ impl Sim {
                 }
             }
         }
-        self.fused(&mut stages, gather, false);
-        Ok(())
+        Ok(stages)
     }
 
     /// Run the cross pass (when `gather`), then `stages`, then the skin check
