@@ -183,6 +183,27 @@ macro_rules! no_step_hooks {
     };
 }
 
+/// `Fix::local` for a fix whose only step hook is `post_force` (a whole
+/// pass): it has nothing to do at the head or the end of the tail, so the
+/// fused stages around it are not split there.
+#[macro_export]
+macro_rules! post_force_only {
+    () => {
+        fn local(
+            &mut self,
+            hook: $crate::engine::fix::Hook,
+            _sim: &$crate::engine::sim::Sim,
+            _vars: &$crate::script::Variables,
+        ) -> $crate::error::Result<$crate::engine::fix::Local> {
+            Ok(if hook == $crate::engine::fix::Hook::PostForce {
+                $crate::engine::fix::Local::Whole
+            } else {
+                $crate::engine::fix::Local::Nothing
+            })
+        }
+    };
+}
+
 /// Placeholder put in a fix's slot while its hook runs.
 pub struct Hole;
 impl Fix for Hole {

@@ -421,6 +421,7 @@ impl WindFix {
 }
 
 impl Fix for WindFix {
+    crate::post_force_only!();
     fn id(&self) -> &str {
         &self.cfg.id
     }

@@ -193,6 +193,7 @@ pub struct Freeze {
 }
 
 impl Fix for Freeze {
+    crate::post_force_only!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -278,6 +279,7 @@ pub struct AddForce {
 }
 
 impl Fix for AddForce {
+    crate::post_force_only!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -326,6 +328,7 @@ pub struct Viscous {
 }
 
 impl Fix for Viscous {
+    crate::post_force_only!();
     fn id(&self) -> &str {
         &self.id
     }

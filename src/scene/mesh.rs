@@ -350,6 +350,7 @@ impl WallGranMesh {
 }
 
 impl Fix for WallGranMesh {
+    crate::post_force_only!();
     fn id(&self) -> &str {
         &self.id
     }
@@ -522,6 +523,7 @@ impl WallGranRegion {
 }
 
 impl Fix for WallGranRegion {
+    crate::post_force_only!();
     fn id(&self) -> &str {
         &self.id
     }
