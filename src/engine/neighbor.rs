@@ -280,21 +280,10 @@ impl PairList {
         self.a.is_empty()
     }
 
-    /// Whether a rebuild is due at `step` (LAMMPS `Neighbor::decide`).
-    pub fn needs_rebuild(&mut self, p: &Particles, s: &NeighSettings, step: i64) -> bool {
-        match self.due(p.len(), s, step) {
-            Due::Build => true,
-            Due::Skip => false,
-            Due::Check => {
-                let moved = self.moved_any(&p.x, s);
-                self.checked(moved, s, step)
-            }
-        }
-    }
-
     /// What `neigh_modify` asks of step `step` with `n` particles: a build
     /// whatever the particles did, a check of how far they moved, or
-    /// nothing.
+    /// nothing (the first half of LAMMPS `Neighbor::decide`; the step's head
+    /// does the check, [`PairList::checked`] the rest).
     pub fn due(&self, n: usize, s: &NeighSettings, step: i64) -> Due {
         if self.x_built.len() != n {
             return Due::Build;
