@@ -1,14 +1,16 @@
 //! The step's head (every fix's initial_integrate and the skin check of
 //! the pair list) and its tail (the cross-block shares of the pair forces,
 //! every fix's post_force, every fix's final_integrate) run fused, chunk by
-//! chunk, where the fixes act particle by particle. That must change no bit
-//! (nor any pair-list build, which would reorder sums): a bed of
+//! chunk, where the fixes act particle by particle; when nothing is output
+//! and no fix has an end_of_step at a step, its tail and the next step's
+//! head run as one pass. That must change no bit (nor any pair-list build, which would reorder sums): a bed of
 //! 3,375 overlapping spheres (more than one block of the pair pass, so pairs
 //! cross blocks) bursts apart and falls with spin onto a frictional floor
 //! with rolling resistance, under gravity, on 2 threads; the fused run and
 //! the run with every hook called on its own write the same dump bytes. A
 //! second deck gives gravity a variable magnitude, which its hook evaluates
-//! itself (not fused), between fused stages.
+//! itself (not fused), between fused stages; a third adds a moving mesh,
+//! whose initial_integrate needs the whole simulation.
 
 use demx::cli::{run_deck, DeckArgs};
 use demx::engine::sim::with_unfused_tail;
@@ -33,7 +35,7 @@ fn data() -> String {
     s
 }
 
-fn deck(dir: &str, gravity: &str) -> String {
+fn deck(dir: &str, gravity: &str, after: &str) -> String {
     format!(
         "atom_style granular\natom_modify map array\nboundary p p f\nnewton off\ncommunicate single vel yes\nunits si\n\
          read_data {dir}/data.spheres\nneighbor 0.0003 bin\nneigh_modify delay 0\n\
@@ -44,19 +46,21 @@ fn deck(dir: &str, gravity: &str) -> String {
          fix m5 all property/global coefficientRollingFriction peratomtypepair 1 0.1\n\
          pair_style gran model hertz tangential history rolling_friction epsd2\npair_coeff * *\ntimestep 5e-6\n\
          fix floor all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 1 zplane 0.0\n\
-         {gravity}\nfix integr all nve/sphere\n\
+         {gravity}\nfix integr all nve/sphere\n{after}\n\
          dump d all custom 100 {dir}/dump.spheres id x y z vx vy vz omegax omegay omegaz fx fy fz\n\
          dump_modify d sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\"\n\
          thermo 100\nthermo_style custom step atoms ke\nrun 600\n"
     )
 }
 
-/// The dump of one run on 2 threads, fused or not, and its pair-list builds.
-fn run(gravity: &str, fused: bool) -> (Vec<u8>, u64) {
+/// The dump of one run on 2 threads, fused or not, and its pair-list
+/// builds; `after` goes after the integrator.
+fn run(gravity: &str, after: &str, fused: bool) -> (Vec<u8>, u64) {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path().to_str().unwrap().to_string();
     std::fs::write(dir.path().join("data.spheres"), data()).unwrap();
-    std::fs::write(dir.path().join("in.spheres"), deck(&d, gravity)).unwrap();
+    std::fs::write(dir.path().join("in.spheres"), deck(&d, gravity, &after.replace("DIR", &d))).unwrap();
+    std::fs::write(dir.path().join("tilt.stl"), TILT).unwrap();
     let args = DeckArgs { deck: dir.path().join("in.spheres"), var: vec![], perturb: None, var_groups: vec![] };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     let go = || {
@@ -82,8 +86,8 @@ fn same((a, builds_a): &(Vec<u8>, u64), (b, builds_b): &(Vec<u8>, u64), what: &s
 #[test]
 fn fused_head_and_tail_change_no_bit() {
     let gravity = "fix grav all gravity 9.81 vector 0.0 0.0 -1.0";
-    let fused = run(gravity, true);
-    same(&fused, &run(gravity, false), "constant gravity");
+    let fused = run(gravity, "", true);
+    same(&fused, &run(gravity, "", false), "constant gravity");
     // the spheres pushed each other apart and the bottom layer met the
     // floor: in the last frame some move up and many spin
     let text = String::from_utf8_lossy(&fused.0);
@@ -94,7 +98,22 @@ fn fused_head_and_tail_change_no_bit() {
     let up = rows.iter().filter(|r| r[6] > 0.0).count();
     assert!(up > 100, "only {up} spheres moving up at the end");
     let var = "variable g equal 9.81*(1+step/1000)\nfix grav all gravity v_g vector 0.0 0.0 -1.0";
-    let fused_var = run(var, true);
-    same(&fused_var, &run(var, false), "variable gravity");
+    let fused_var = run(var, "", true);
+    same(&fused_var, &run(var, "", false), "variable gravity");
     assert_ne!(fused_var, fused, "the variable gravity changed nothing");
+    // a moving mesh: its initial_integrate (after the integrator's) needs
+    // the whole simulation, so the step's tail and the next step's head,
+    // fused, must run the integrator's halves on either side of it
+    let mesh = "fix cad all mesh/surface file DIR/tilt.stl type 1\n\
+                fix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
+                fix mv all move/mesh mesh cad linear 0.5 0 0";
+    let fused_mesh = run(gravity, mesh, true);
+    same(&fused_mesh, &run(gravity, mesh, false), "moving mesh");
+    assert_ne!(fused_mesh, fused, "the mesh changed nothing");
 }
+
+/// A tilted square across the box, 0.1-0.4 mm above the floor: it touches
+/// through the bottom layer of spheres.
+const TILT: &str = "solid tilt\nfacet normal 0 0 1\nouter loop\nvertex -0.016 -0.016 0.0001\nvertex 0.016 -0.016 0.0004\n\
+vertex 0.016 0.016 0.0004\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex -0.016 -0.016 0.0001\n\
+vertex 0.016 0.016 0.0004\nvertex -0.016 0.016 0.0001\nendloop\nendfacet\nendsolid tilt\n";

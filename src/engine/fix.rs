@@ -112,6 +112,13 @@ pub trait Fix: Send {
     fn end_of_step(&mut self, _sim: &mut Sim, _vars: &Variables) -> Result<()> {
         Ok(())
     }
+    /// Whether `end_of_step` may do anything at `step`. When no fix's is
+    /// due and no output is, the step's tail runs fused with the next
+    /// step's head, and `end_of_step` is not called at that step. The
+    /// default says yes; a fix without an end_of_step says no.
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        true
+    }
     /// Global scalar `f_ID`.
     fn scalar(&self, _sim: &Sim) -> Option<f64> {
         None
@@ -185,7 +192,7 @@ macro_rules! no_step_hooks {
 
 /// `Fix::local` for a fix whose only step hook is `post_force` (a whole
 /// pass): it has nothing to do at the head or the end of the tail, so the
-/// fused stages around it are not split there.
+/// fused stages around it are not split there; nor at the end of the step.
 #[macro_export]
 macro_rules! post_force_only {
     () => {
@@ -201,6 +208,9 @@ macro_rules! post_force_only {
                 $crate::engine::fix::Local::Nothing
             })
         }
+        fn end_of_step_due(&self, _step: i64) -> bool {
+            false
+        }
     };
 }
 
@@ -208,6 +218,9 @@ macro_rules! post_force_only {
 pub struct Hole;
 impl Fix for Hole {
     crate::no_step_hooks!();
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         ""
     }

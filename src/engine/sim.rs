@@ -12,7 +12,7 @@ use crate::physics::V3;
 use crate::script::{EvalContext, Variables};
 use std::time::Instant;
 
-/// Particles per chunk of the step's fused tail ([`Sim::tail`]): small enough
+/// Particles per chunk of the step's fused head and tail ([`Sim::fused`]): small enough
 /// that a chunk's entries stay in cache from one stage to the next, and that
 /// two threads get equal shares of a 30,000-particle bed.
 const TAIL_CHUNK: usize = 1024;
@@ -265,7 +265,7 @@ impl Sim {
     }
 
     /// The force pass of [`Sim::pair_forces_dt`] without its cross pass,
-    /// which the step's fused tail runs (`tail`).
+    /// which the step's fused tail runs (`one_step`).
     fn pair_pass(&mut self, dt: f64) {
         self.pair_virial = 0.0;
         let p = &mut self.particles;
@@ -322,8 +322,9 @@ impl Sim {
         // the other threads stay awake between the step's parallel loops
         let _awake = super::awake::Awake::start();
         let t0 = Instant::now();
+        let mut carried = None;
         for _ in 0..n {
-            self.one_step(vars)?;
+            carried = self.one_step(vars, carried)?;
             super::output::show_progress(self, t0, n);
         }
         let secs = t0.elapsed().as_secs_f64();
@@ -334,13 +335,23 @@ impl Sim {
         Ok(())
     }
 
-    fn one_step(&mut self, vars: &Variables) -> Result<()> {
-        self.step += 1;
-        self.time += self.dt;
+    /// One step. `carried`: the previous step's tail already ran this
+    /// step's head (and advanced the clock), which gave this answer of the
+    /// skin check. Returns the same for the next step when this step's tail
+    /// runs its head ([`Sim::fuse_next`]).
+    fn one_step(&mut self, vars: &Variables, carried: Option<bool>) -> Result<Option<bool>> {
         let t = Instant::now();
+        let moved = match carried {
+            Some(moved) => moved,
+            None => {
+                self.step += 1;
+                self.time += self.dt;
+                let due = self.pairs.due(self.particles.len(), &self.neigh, self.step);
+                self.head(vars, due == Due::Check)?
+            }
+        };
         let step = self.step;
         let due = self.pairs.due(self.particles.len(), &self.neigh, step);
-        let moved = self.head(vars, due == Due::Check)?;
         let wanted = self.fixes.iter().any(|f| f.next_reneighbor() == Some(step));
         let tm = t.elapsed().as_secs_f64();
         let t = Instant::now();
@@ -359,8 +370,33 @@ impl Sim {
         let t = Instant::now();
         self.pair_pass(self.dt);
         let tp = t.elapsed().as_secs_f64();
+        // the step's tail: the cross-block shares of the pair forces, then
+        // every fix's post_force, then every fix's final_integrate, in
+        // LAMMPS order. Hooks that act particle by particle ([`Fix::local`])
+        // run fused, chunk by chunk, so a bed's forces and velocities pass
+        // through the cache once instead of once per hook; each particle
+        // meets the same operations in the same order, so the bits are those
+        // of one pass per hook. A hook that needs the whole simulation ends
+        // the fused run before it and is called as it is.
         let t = Instant::now();
-        self.tail(vars)?;
+        let mut gather = true;
+        let mut stages = vec![];
+        self.hooks(&[Hook::PostForce, Hook::FinalIntegrate], vars, &mut gather, &mut stages)?;
+        if self.fuse_next() {
+            // nothing reads the state between this tail and the next head:
+            // run them as one pass (each particle meets the same operations
+            // in the same order, so the bits are those of two passes)
+            self.step += 1;
+            self.time += self.dt;
+            let due = self.pairs.due(self.particles.len(), &self.neigh, self.step);
+            self.hooks(&[Hook::InitialIntegrate], vars, &mut gather, &mut stages)?;
+            let moved = self.fused(&mut stages, gather, due == Due::Check);
+            self.timing[0] += tp;
+            self.timing[1] += tn;
+            self.timing[2] += tm + t.elapsed().as_secs_f64();
+            return Ok(Some(moved));
+        }
+        self.fused(&mut stages, gather, false);
         self.each_fix(|f, s| f.end_of_step(s, vars))?;
         if self.guard.due(self.step) {
             super::guard::check(self, false)?;
@@ -372,16 +408,34 @@ impl Sim {
         self.timing[1] += tn;
         self.timing[2] += tm + tm2;
         self.timing[3] += t.elapsed().as_secs_f64();
-        Ok(())
+        Ok(None)
+    }
+
+    /// Whether nothing reads or changes the state between this step's tail
+    /// and the next step's head: the run goes on, no fix has an end_of_step
+    /// to do ([`Fix::end_of_step_due`]), and neither the guard nor any
+    /// output is due. Then the two run as one pass over the particles, so a
+    /// bed beyond the cache streams its arrays from memory once per step
+    /// instead of twice.
+    fn fuse_next(&self) -> bool {
+        let step = self.step;
+        let every = self.thermo.every;
+        step < self.run_end
+            && !UNFUSED.with(|u| u.get())
+            && !(every > 0 && step % every == 0)
+            && !self.guard.due(step)
+            && !self.dumps.iter().any(|d| d.due(step, false))
+            && !self.fixes.iter().any(|f| f.end_of_step_due(step))
     }
 
     /// The step's head: every fix's initial_integrate, fused chunk by chunk
-    /// where the fixes act particle by particle (as [`Sim::tail`]); with
+    /// where the fixes act particle by particle (as the tail); with
     /// `check`, the same pass then tells whether a particle moved more than
     /// half the skin since the last build ([`PairList::moved`]), over the
     /// positions after every fix's initial_integrate.
     fn head(&mut self, vars: &Variables, check: bool) -> Result<bool> {
-        let mut stages = self.hooks(&[Hook::InitialIntegrate], vars, &mut false)?;
+        let mut stages = vec![];
+        self.hooks(&[Hook::InitialIntegrate], vars, &mut false, &mut stages)?;
         if UNFUSED.with(|u| u.get()) {
             // the check on its own, as tests compare
             return Ok(check && self.pairs.moved_any(&self.particles.x, &self.neigh));
@@ -389,26 +443,10 @@ impl Sim {
         Ok(self.fused(&mut stages, false, check))
     }
 
-    /// The step after the pair pass: the cross-block shares of the pair
-    /// forces, then every fix's post_force, then every fix's final_integrate,
-    /// in LAMMPS order. Hooks that act particle by particle ([`Fix::local`])
-    /// run fused, chunk by chunk, so a bed's forces and velocities pass
-    /// through the cache once instead of once per hook; each particle meets
-    /// the same operations in the same order, so the bits are those of one
-    /// pass per hook. A hook that needs the whole simulation ends the fused
-    /// run before it and is called as it is.
-    fn tail(&mut self, vars: &Variables) -> Result<()> {
-        let mut gather = true;
-        let mut stages = self.hooks(&[Hook::PostForce, Hook::FinalIntegrate], vars, &mut gather)?;
-        self.fused(&mut stages, gather, false);
-        Ok(())
-    }
-
-    /// Every fix's `hooks`, in order: a fix's stage joins the pending ones,
-    /// a whole hook first runs the pending stages (and the cross pass, while
-    /// `gather`) and is then called. Returns the stages still pending.
-    fn hooks(&mut self, hooks: &[Hook], vars: &Variables, gather: &mut bool) -> Result<Vec<Box<dyn Stage>>> {
-        let mut stages: Vec<Box<dyn Stage>> = vec![];
+    /// Every fix's `hooks`, in order: a fix's stage joins the pending
+    /// `stages`, a whole hook first runs them (and the cross pass, while
+    /// `gather`) and is then called. Leaves the stages still pending.
+    fn hooks(&mut self, hooks: &[Hook], vars: &Variables, gather: &mut bool, stages: &mut Vec<Box<dyn Stage>>) -> Result<()> {
         let fuse = !UNFUSED.with(|u| u.get());
         for &hook in hooks {
             for k in 0..self.fixes.len() {
@@ -416,7 +454,7 @@ impl Sim {
                 let local = if fuse { fix.local(hook, self, vars) } else { Ok(Local::Whole) };
                 let local = match local {
                     Ok(Local::Whole) => {
-                        self.fused(&mut stages, std::mem::take(gather), false);
+                        self.fused(stages, std::mem::take(gather), false);
                         match hook {
                             Hook::PostForce => fix.post_force(self, vars).map(|_| Local::Nothing),
                             Hook::InitialIntegrate => {
@@ -437,7 +475,7 @@ impl Sim {
                 }
             }
         }
-        Ok(stages)
+        Ok(())
     }
 
     /// Run the cross pass (when `gather`), then `stages`, then the skin check

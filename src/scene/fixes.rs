@@ -18,6 +18,9 @@ pub struct NveSphere {
 }
 
 impl Fix for NveSphere {
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
@@ -51,6 +54,9 @@ pub struct Nve {
 }
 
 impl Fix for Nve {
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
@@ -116,6 +122,9 @@ impl Magnitude {
 }
 
 impl Fix for Gravity {
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
@@ -375,9 +384,12 @@ impl Fix for Print {
         }
         Ok(())
     }
+    fn end_of_step_due(&self, step: i64) -> bool {
+        self.every > 0 && step % self.every == 0
+    }
     fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
         use std::io::Write;
-        if self.every <= 0 || sim.step % self.every != 0 {
+        if !self.end_of_step_due(sim.step) {
             return Ok(());
         }
         let line = vars.substitute_word(&self.text, sim)?;
@@ -535,18 +547,20 @@ impl Fix for AveTime {
     fn style(&self) -> &str {
         "ave/time"
     }
+    /// A sampling step: the window of output step s samples
+    /// s - (Nrepeat-1) Nevery ... s.
+    fn end_of_step_due(&self, step: i64) -> bool {
+        let next_out = ((step + self.nfreq - 1) / self.nfreq) * self.nfreq;
+        let first = next_out - (self.nrepeat - 1) * self.nevery;
+        step >= self.start && step >= first && (step - first) % self.nevery == 0
+    }
     fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
         use std::io::Write;
         let step = sim.step;
-        if step < self.start {
+        if !self.end_of_step_due(step) {
             return Ok(());
         }
-        // the window of output step s samples s - (Nrepeat-1) Nevery ... s
         let next_out = ((step + self.nfreq - 1) / self.nfreq) * self.nfreq;
-        let first = next_out - (self.nrepeat - 1) * self.nevery;
-        if step < first || (step - first) % self.nevery != 0 {
-            return Ok(());
-        }
         let vals = self.sample(sim, vars)?;
         if self.sums.len() != vals.len() {
             self.sums = vec![0.0; vals.len()];
@@ -703,8 +717,11 @@ impl Fix for CheckTimestep {
         self.compute(sim);
         Ok(())
     }
+    fn end_of_step_due(&self, step: i64) -> bool {
+        self.every > 0 && step % self.every == 0
+    }
     fn end_of_step(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
-        if self.every > 0 && sim.step % self.every == 0 {
+        if self.end_of_step_due(sim.step) {
             self.compute(sim);
             if self.fractions.0 > self.limit.0 {
                 sim.log.line(&format!("WARNING: time-step is {:.6} % of rayleigh time", 100.0 * self.fractions.0));

@@ -210,8 +210,11 @@ impl Fix for Adapt {
         }
         self.change(sim, vars)
     }
+    fn end_of_step_due(&self, step: i64) -> bool {
+        self.nevery > 0 && (step + 1) % self.nevery == 0
+    }
     fn end_of_step(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
-        if self.nevery > 0 && (sim.step + 1) % self.nevery == 0 && sim.step < sim.run_end {
+        if self.end_of_step_due(sim.step) && sim.step < sim.run_end {
             self.change(sim, vars)?;
         }
         Ok(())
@@ -275,6 +278,9 @@ impl Template {
 
 impl Fix for Template {
     crate::no_step_hooks!();
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
@@ -444,6 +450,9 @@ impl Distribution {
 
 impl Fix for Distribution {
     crate::no_step_hooks!();
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
@@ -1555,6 +1564,10 @@ impl Fix for LiggghtsInsert {
         self.schedule_next(more);
         Ok(())
     }
+    /// Particles of an insert/stream still on their way into the box.
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        self.stream.as_ref().is_some_and(|f| !f.release.is_empty())
+    }
     fn end_of_step(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
         let Some(mut f) = self.stream.take() else { return Ok(()) };
         if !f.release.is_empty() {
@@ -1978,6 +1991,9 @@ fn parse_pour(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args
 
 impl Fix for Pour {
     crate::no_step_hooks!();
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }

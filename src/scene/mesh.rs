@@ -53,6 +53,9 @@ pub struct MeshSurfaceFix {
 
 impl Fix for MeshSurfaceFix {
     crate::no_step_hooks!();
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
@@ -260,6 +263,9 @@ pub struct MoveMeshFix {
 }
 
 impl Fix for MoveMeshFix {
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn local(&mut self, hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
         // the mesh's clock advances in initial_integrate
         Ok(if hook == Hook::InitialIntegrate { Local::Whole } else { Local::Nothing })

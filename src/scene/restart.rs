@@ -259,8 +259,11 @@ impl Fix for RestartWriter {
     fn style(&self) -> &str {
         "restart"
     }
+    fn end_of_step_due(&self, step: i64) -> bool {
+        self.every > 0 && step % self.every == 0
+    }
     fn end_of_step(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
-        if self.every <= 0 || sim.step % self.every != 0 || sim.dry {
+        if !self.end_of_step_due(sim.step) || sim.dry {
             return Ok(());
         }
         let name = if self.files.len() == 2 {

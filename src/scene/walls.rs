@@ -191,6 +191,9 @@ impl WallGran {
 }
 
 impl Fix for WallGran {
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
