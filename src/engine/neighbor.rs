@@ -88,6 +88,9 @@ pub struct PairList {
     pub cross: Vec<u32>,
     /// Slot where each block's cross pairs start (blocks + 1 entries).
     pub block_cross: Vec<u32>,
+    /// Per cross pair, in pair order: its slot, counted from its block's
+    /// first ([`PairList::block_cross`]).
+    pub xslot: Vec<u32>,
 }
 
 /// Particles per block of the force pass. Fixed, never derived from the
@@ -488,20 +491,19 @@ impl PairList {
         for q in 0..nblocks {
             self.block_start[q + 1] += self.block_start[q];
         }
-        // cross pairs get consecutive slots in pair order (so each block's
-        // slots are a range), and each particle lists the slots where it is b
-        // (the force pass counts the slots in the same order, so the pairs
-        // do not keep them)
-        let mut cslot = vec![u32::MAX; m];
-        self.block_cross = vec![0; nblocks + 1];
+        // each block's cross pairs (those whose b lies in another block)
+        // get a range of slots, and each particle lists the slots where it
+        // is b, in increasing pair index (the order its shares are added)
         let mut ccount = vec![0u32; n + 1];
-        let mut slots = 0u32;
+        self.block_cross = vec![0; nblocks + 1];
+        let mut ord = vec![u32::MAX; m];
+        let mut ncross = 0u32;
         for k in 0..m {
             let (a, b) = (self.a[k] as usize, self.b[k] as usize);
             if a / bs != b / bs {
                 ccount[b + 1] += 1;
-                cslot[k] = slots;
-                slots += 1;
+                ord[k] = ncross;
+                ncross += 1;
                 self.block_cross[a / bs + 1] += 1;
             }
         }
@@ -512,13 +514,26 @@ impl PairList {
             ccount[i + 1] += ccount[i];
         }
         let mut fill = ccount.clone();
-        self.cross = vec![0; ccount[n] as usize];
+        let mut by_b = vec![0u32; ncross as usize];
         for k in 0..m {
-            let b = self.b[k] as usize;
-            if cslot[k] != u32::MAX {
-                self.cross[fill[b] as usize] = cslot[k];
+            if ord[k] != u32::MAX {
+                let b = self.b[k] as usize;
+                by_b[fill[b] as usize] = k as u32;
                 fill[b] += 1;
             }
+        }
+        // within a block's range, slots go by b (then pair index): the cross
+        // pass, particle after particle, then reads each block's range in
+        // order instead of at random (the force pass finds a pair's slot in
+        // `xslot`, the n-th cross pair of the walk at `xslot[n]`)
+        let mut next = self.block_cross.clone();
+        self.xslot = vec![0; ncross as usize];
+        self.cross = vec![0; ncross as usize];
+        for (c, &k) in by_b.iter().enumerate() {
+            let q = self.a[k as usize] as usize / bs;
+            self.cross[c] = next[q];
+            self.xslot[ord[k as usize] as usize] = next[q] - self.block_cross[q];
+            next[q] += 1;
         }
         self.cross_start = ccount;
     }
