@@ -15,5 +15,6 @@ pub mod mesh_surface;
 pub mod wind;
 pub mod guard;
 pub mod awake;
+pub mod hugepages;
 
 pub use sim::{Dialect, Sim};
