@@ -341,17 +341,14 @@ impl Sim {
     /// runs its head ([`Sim::fuse_next`]).
     fn one_step(&mut self, vars: &Variables, carried: Option<bool>) -> Result<Option<bool>> {
         let t = Instant::now();
-        let moved = match carried {
-            Some(moved) => moved,
+        let (moved, due) = match carried {
+            Some(moved) => (moved, self.due()),
             None => {
-                self.step += 1;
-                self.time += self.dt;
-                let due = self.pairs.due(self.particles.len(), &self.neigh, self.step);
-                self.head(vars, due == Due::Check)?
+                let due = self.advance();
+                (self.head(vars, due == Due::Check)?, due)
             }
         };
         let step = self.step;
-        let due = self.pairs.due(self.particles.len(), &self.neigh, step);
         let wanted = self.fixes.iter().any(|f| f.next_reneighbor() == Some(step));
         let tm = t.elapsed().as_secs_f64();
         let t = Instant::now();
@@ -382,33 +379,44 @@ impl Sim {
         let mut gather = true;
         let mut stages = vec![];
         self.hooks(&[Hook::PostForce, Hook::FinalIntegrate], vars, &mut gather, &mut stages)?;
-        if self.fuse_next() {
+        let next = if self.fuse_next() {
             // nothing reads the state between this tail and the next head:
             // run them as one pass (each particle meets the same operations
             // in the same order, so the bits are those of two passes)
-            self.step += 1;
-            self.time += self.dt;
-            let due = self.pairs.due(self.particles.len(), &self.neigh, self.step);
+            let due = self.advance();
             self.hooks(&[Hook::InitialIntegrate], vars, &mut gather, &mut stages)?;
-            let moved = self.fused(&mut stages, gather, due == Due::Check);
-            self.timing[0] += tp;
-            self.timing[1] += tn;
-            self.timing[2] += tm + t.elapsed().as_secs_f64();
-            return Ok(Some(moved));
-        }
-        self.fused(&mut stages, gather, false);
-        self.each_fix(|f, s| f.end_of_step(s, vars))?;
-        if self.guard.due(self.step) {
-            super::guard::check(self, false)?;
-        }
+            Some(self.fused(&mut stages, gather, due == Due::Check))
+        } else {
+            self.fused(&mut stages, gather, false);
+            self.each_fix(|f, s| f.end_of_step(s, vars))?;
+            if self.guard.due(self.step) {
+                super::guard::check(self, false)?;
+            }
+            None
+        };
         let tm2 = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        self.output(vars, false)?;
+        if next.is_none() {
+            self.output(vars, false)?;
+        }
         self.timing[0] += tp;
         self.timing[1] += tn;
         self.timing[2] += tm + tm2;
         self.timing[3] += t.elapsed().as_secs_f64();
-        Ok(None)
+        Ok(next)
+    }
+
+    /// Start the next step: advance the step and the clock; returns what
+    /// that step owes the pair list.
+    fn advance(&mut self) -> Due {
+        self.step += 1;
+        self.time += self.dt;
+        self.due()
+    }
+
+    /// What this step owes the pair list.
+    fn due(&self) -> Due {
+        self.pairs.due(self.particles.len(), &self.neigh, self.step)
     }
 
     /// Whether nothing reads or changes the state between this step's tail
