@@ -35,7 +35,7 @@ def main():
                 w = line.split()
                 if line.startswith("Loop time"):
                     res[b]["Loop"].append(float(w[3]))
-                elif len(w) > 2 and w[0] in keys:
+                elif len(w) > 2 and w[0] in keys and w[1] == "|":
                     res[b][w[0]].append(float(w[2]))
     for b in a.bins:
         print(b, "  ".join(f"{k} min {min(v):.3f} med {statistics.median(v):.3f}" for k, v in res[b].items() if v))

@@ -26,8 +26,8 @@
 //!
 //! [`Fix::max_surface_overlap`]: super::fix::Fix::max_surface_overlap
 
-use super::neighbor::{PairList, ADJ_B};
 use super::integrate::in_chunks;
+use super::neighbor::{PairList, ADJ_B};
 use super::particles::Particles;
 use super::sim::{Dialect, Sim};
 use crate::error::Error;
@@ -194,7 +194,7 @@ pub fn on_lost(sim: &mut Sim) -> Option<Error> {
 /// removal since it was built).
 fn pairs_valid(sim: &Sim) -> bool {
     let n = sim.particles.len();
-    !sim.force_rebuild && sim.pairs.x_built.len() == n && sim.pairs.adj_start.len() == n + 1
+    !sim.force_rebuild && sim.pairs.x_built.len() == n && sim.pairs.indexed(n)
 }
 
 /// Remember the pairs that overlap noticeably at the start of a run.
@@ -400,8 +400,9 @@ fn contacts_of(sim: &Sim, i: usize) -> Vec<(String, f64)> {
     let p = &sim.particles;
     let mut out: Vec<(String, f64)> = vec![];
     let pl = &sim.pairs;
-    if pairs_valid(sim) && i + 1 < pl.adj_start.len() {
-        for &e in &pl.adj[pl.adj_start[i] as usize..pl.adj_start[i + 1] as usize] {
+    if pairs_valid(sim) && i < p.len() {
+        let (start, adj) = pl.adjacency(p.len());
+        for &e in &adj[start[i] as usize..start[i + 1] as usize] {
             let k = (e & !ADJ_B) as usize;
             if k >= pl.len() {
                 continue;
@@ -517,14 +518,8 @@ fn fail(sim: &mut Sim, trip: Trip, at_setup: bool) -> Error {
             ));
         }
     }
-    let ts_text = g.timestep.map(|t| {
-        format!(
-            "timestep {} is {} of the Hertz time and {} of the Rayleigh time",
-            g4(sim.dt),
-            pct(t.hertz),
-            pct(t.rayleigh)
-        )
-    });
+    let ts_text =
+        g.timestep.map(|t| format!("timestep {} is {} of the Hertz time and {} of the Rayleigh time", g4(sim.dt), pct(t.hertz), pct(t.rayleigh)));
     let ts_big = g.timestep.map_or(false, |t| t.hertz.max(t.rayleigh) > TIMESTEP_SUSPECT_FRACTION);
     if ts_big {
         causes.push(format!(
@@ -595,16 +590,7 @@ fn write_last_good(sim: &Sim, file: &str) -> std::io::Result<Option<i64>> {
         let (lo, hi) = sim.domain.as_ref().map_or(([0.0; 3], [0.0; 3]), |d| (d.lo, d.hi));
         (atoms, lo, hi, sim.step, None)
     };
-    let df = DataFile {
-        title: String::new(),
-        atom_types: sim.ntypes.max(1) as u32,
-        lo,
-        hi,
-        tilt: None,
-        masses: vec![],
-        atoms,
-        has_velocities: true,
-    };
+    let df = DataFile { title: String::new(), atom_types: sim.ntypes.max(1) as u32, lo, hi, tilt: None, masses: vec![], atoms, has_velocities: true };
     let engine = if sim.dialect == Dialect::Liggghts { crate::io::dump::Engine::Liggghts } else { crate::io::dump::Engine::Lammps };
     let text = format_data(&df, engine, step.max(0) as u64);
     let path = std::path::Path::new(file);

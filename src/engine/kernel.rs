@@ -277,7 +277,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             pairs.live = vec![1; m];
         }
         let PairList { a, b, image, images, hist, live, block_start, block_cross, xslot, .. } = pairs;
-        let (a, b, image, images, block_start, block_cross, xslot) = (&a[..], &b[..], &image[..], &images[..], &block_start[..], &block_cross[..], &xslot[..]);
+        let (a, b, image, images, block_start, block_cross, xslot) =
+            (&a[..], &b[..], &image[..], &images[..], &block_start[..], &block_cross[..], &xslot[..]);
         // split the pairs' history and deferred slots at the block ranges
         let nblocks = block_start.len().saturating_sub(1);
         let mut jobs = Vec::with_capacity(nblocks);
@@ -328,6 +329,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                 let reach = p.radius[i] + p.radius[j] + if beyond { pp.extra_range } else { 0.0 };
                 if N::CONTACT_ONLY && (p.x[i] - xj).norm_squared() >= reach * reach {
                     hk.fill(0.0);
+                    lv[k - ps] = 0;
                     continue;
                 }
                 let Some((c, _)) = pair_contact(p, i, j, xj, dt) else {
@@ -335,6 +337,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                 };
                 if N::CONTACT_ONLY && (c.delta <= -pp.extra_range || (c.delta <= 0.0 && !C::NONCONTACT)) {
                     hk.fill(0.0);
+                    lv[k - ps] = 0;
                     continue;
                 }
                 let o = self.apply(&c, pp, hk);
@@ -861,7 +864,12 @@ mod tests {
         assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
         // LIGGGHTS hooke/stiffness + history
         use crate::physics::normal::hooke_stiffness::LiggghtsHookeStiffness;
-        let laws = Laws { normal: LiggghtsHookeStiffness { absolute_damping: false }, tangential: LiggghtsHistory, cohesion: NoCohesion, rolling: NoRolling };
+        let laws = Laws {
+            normal: LiggghtsHookeStiffness { absolute_damping: false },
+            tangential: LiggghtsHistory,
+            cohesion: NoCohesion,
+            rolling: NoRolling,
+        };
         let table = two_type_table(|q, s| {
             q.kn = 1e4 * s as f64;
             q.kt = 3e3 * s as f64;
@@ -878,7 +886,12 @@ mod tests {
         use crate::physics::normal::viscoelastic::PaperViscoelastic;
         use crate::physics::rolling::paper::PaperEpsd;
         use crate::physics::tangential::paper::PaperCundallStrack;
-        let laws = Laws { normal: PaperViscoelastic, tangential: PaperCundallStrack, cohesion: Hamaker { tangential_reduce: false }, rolling: PaperEpsd { torsion_torque: false } };
+        let laws = Laws {
+            normal: PaperViscoelastic,
+            tangential: PaperCundallStrack,
+            cohesion: Hamaker { tangential_reduce: false },
+            rolling: PaperEpsd { torsion_torque: false },
+        };
         assert!(Laws::<PaperViscoelastic, PaperCundallStrack, Hamaker, PaperEpsd>::BATCHED);
         let table = two_type_table(|q, s| {
             q.y_eff = 1e4 * s as f64;

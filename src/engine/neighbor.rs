@@ -7,6 +7,16 @@
 //! particle. History is carried across rebuilds keyed by the two ids.
 //! Per-particle adjacency (CSR) lists each particle's pairs in increasing pair
 //! index, so forces can be gathered in a fixed order on any thread count.
+//!
+//! Between builds the list is pruned (as GROMACS prunes its pair list
+//! dynamically): of the pairs within the skin, the list proper keeps those
+//! within a smaller buffer of touching at the current positions, and is
+//! pruned again from the full list once a particle has moved half that
+//! buffer. A settled bed's list within the skin is mostly pairs apart that
+//! cannot touch for many steps; the force pass then walks about half of
+//! them. Pruning changes no result: a pair left out is apart by more than
+//! the buffer, so it would have added nothing, and the pairs kept are added
+//! in the same order.
 
 use super::domain::Domain;
 use super::integrate::{in_chunks, CHUNK};
@@ -53,17 +63,12 @@ pub struct PairList {
     /// Per pair: 1 if its history may be non-zero (bit 0; the force pass
     /// uses one more bit while it runs). A pair found apart with 0 here is
     /// skipped without touching its history: most listed pairs are within
-    /// the skin but apart, and stay so.
+    /// the skin but apart, and stay so. A prune keeps every live pair.
     pub live: Vec<u8>,
     /// History values, `width` per pair.
     pub hist: Vec<f64>,
     /// History values per pair.
     pub width: usize,
-    /// CSR offsets into `adj` per particle (len = n + 1).
-    pub adj_start: Vec<u32>,
-    /// For each particle, its pairs in increasing pair index; the high bit
-    /// marks pairs where the particle is `b`.
-    pub adj: Vec<u32>,
     /// Ids of (a, b) at the last build: history is matched by these.
     pub keys: Vec<(i64, i64)>,
     /// Positions at the last build (for the skin check).
@@ -75,7 +80,7 @@ pub struct PairList {
     /// Number of dangerous builds (a particle had moved more than half the
     /// skin when the list was rebuilt on schedule).
     pub dangerous: u64,
-    /// Particles per block of the force pass (0: [`BLOCK`]). Pairs are
+    /// Particles per block of the force pass (0: [`BLOCK`]; a power of two). Pairs are
     /// sorted by their first particle, so the pairs of one block are a range.
     pub block: usize,
     /// Pair index where each block's pairs start (blocks + 1 entries).
@@ -91,6 +96,95 @@ pub struct PairList {
     /// Per cross pair, in pair order: its slot, counted from its block's
     /// first ([`PairList::block_cross`]).
     pub xslot: Vec<u32>,
+    /// The full list of the last build while the list proper holds a
+    /// pruned part of it ([`PairList::prune`]); `None`: the list is full.
+    pub outer: Option<Box<Outer>>,
+    /// Positions at the last prune, in single precision (empty while the
+    /// list is full).
+    pub x_pruned: Vec<[f32; 3]>,
+    /// Squared displacement since the last prune beyond which some pair
+    /// left out might touch: half the buffer, less the rounding of
+    /// `x_pruned`, squared.
+    pub prune_lim: f64,
+    /// Buffer beyond touching (and the pair's extra range) that the last
+    /// prune kept.
+    pub buffer: f64,
+    /// Step of the last prune.
+    pub pruned_at: i64,
+    /// Number of prunes so far.
+    pub prunes: u64,
+    /// What the last check measured (see [`Travel`]).
+    pub travel: Travel,
+}
+
+/// The larger of a running maximum `m` and `d`, which a NaN `d` leaves as
+/// it is (as `f64::max` does; written so, it compiles to the vector max).
+#[inline(always)]
+fn max(m: f64, d: f64) -> f64 {
+    if d > m {
+        d
+    } else {
+        m
+    }
+}
+
+/// The full list of a build, of which a pruned list keeps a part.
+#[derive(Clone, Debug, Default)]
+pub struct Outer {
+    a: Vec<u32>,
+    b: Vec<u32>,
+    image: Vec<u8>,
+    keys: Vec<(i64, i64)>,
+    /// Per pair: its index in the pruned list, or [`NONE`].
+    inner: Vec<u32>,
+    /// Scratch of a prune: the pairs kept, and each one's index in the
+    /// list before (the list's length for none).
+    kept: Vec<u32>,
+    from: Vec<u32>,
+}
+
+/// No index (a pair of the full list that the pruned list left out).
+const NONE: u32 = u32::MAX;
+
+/// How far particles moved: the largest squared displacement since the
+/// last build and since the last prune (a maximum, so the same on any
+/// thread count; both 0 where not measured).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Travel {
+    /// Since the last build.
+    pub built: f64,
+    /// Since the last prune.
+    pub pruned: f64,
+}
+
+impl Travel {
+    /// The larger of each.
+    pub fn max(self, o: Travel) -> Travel {
+        Travel { built: self.built.max(o.built), pruned: self.pruned.max(o.pruned) }
+    }
+}
+
+/// Steps between prunes that the buffer is chosen for, from the speed of
+/// the fastest particle: a prune costs about a force pass's walk over the
+/// full list, and pays when it spares many walks over the pairs it drops.
+const PRUNE_STEPS: f64 = 16.0;
+/// Smallest buffer, as a fraction of the skin.
+const PRUNE_MIN: f64 = 1.0 / 64.0;
+/// A buffer this fraction of the skin or more: the list stays full.
+const PRUNE_MAX: f64 = 0.5;
+
+thread_local! {
+    /// Tests set it to keep the list full, to check that pruning changes
+    /// no bit.
+    static NO_PRUNE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Run `f` with pair-list pruning switched off on this thread (tests).
+pub fn without_pruning<T>(f: impl FnOnce() -> T) -> T {
+    NO_PRUNE.with(|u| u.set(true));
+    let r = f();
+    NO_PRUNE.with(|u| u.set(false));
+    r
 }
 
 /// Particles per block of the force pass. Fixed, never derived from the
@@ -104,7 +198,11 @@ enum Carry {
     None,
     /// Storage unchanged: the old pairs of particle `i` are
     /// `start[i]..start[i + 1]`, sorted by `b`.
-    ByIndex { start: Vec<u32>, b: Vec<u32>, hist: Vec<f64> },
+    ByIndex {
+        start: Vec<u32>,
+        b: Vec<u32>,
+        hist: Vec<f64>,
+    },
     /// Non-zero history by id pair.
     ById(HashMap<(i64, i64), Vec<f64>, BuildHasherDefault<IdHasher>>),
 }
@@ -302,24 +400,53 @@ impl PairList {
         }
     }
 
-    /// Whether any particle (at `x`) moved more than half the skin since the
-    /// last build, as a pass of its own.
-    pub fn moved_any(&self, x: &[V3], s: &NeighSettings) -> bool {
-        // a yes/no over all particles: the same answer on any thread count
+    /// [`PairList::travel`] of all particles (at `x`), as a pass of its own.
+    pub fn travel_all(&self, x: &[V3], built: bool) -> Travel {
+        // maxima over fixed chunks: the same on any thread count
         if x.len() >= 2 * CHUNK {
             use rayon::prelude::*;
-            x.par_chunks(CHUNK).enumerate().any(|(c, x)| self.moved(x, c * CHUNK, s))
+            x.par_chunks(CHUNK).enumerate().map(|(c, x)| self.travel(x, c * CHUNK, built)).reduce(Travel::default, Travel::max)
         } else {
-            self.moved(x, 0, s)
+            self.travel(x, 0, built)
         }
     }
 
-    /// Whether any of the particles `lo..lo + x.len()` (at `x`) moved more
-    /// than half the skin since the last build (LAMMPS `Neighbor::check_distance`).
+    /// How far the particles `lo..lo + x.len()` (at `x`) moved: since the
+    /// last build when `built` (for the skin check, LAMMPS
+    /// `Neighbor::check_distance`), since the last prune while the list is
+    /// pruned.
     #[inline]
-    pub fn moved(&self, x: &[V3], lo: usize, s: &NeighSettings) -> bool {
-        let lim = 0.25 * s.skin * s.skin;
-        x.iter().zip(&self.x_built[lo..lo + x.len()]).any(|(x, x0)| (x - x0).norm_squared() > lim)
+    pub fn travel(&self, x: &[V3], lo: usize, built: bool) -> Travel {
+        let mut t = Travel::default();
+        if built {
+            t.built = x.iter().zip(&self.x_built[lo..lo + x.len()]).map(|(x, x0)| (x - x0).norm_squared()).fold(0.0, max);
+        }
+        if let Some(xp) = self.x_pruned.get(lo..lo + x.len()) {
+            let d2 = |x: &V3, p: &[f32; 3]| {
+                let d = [x.x - p[0] as f64, x.y - p[1] as f64, x.z - p[2] as f64];
+                d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            };
+            t.pruned = x.iter().zip(xp).map(|(x, p)| d2(x, p)).fold(0.0, max);
+        }
+        t
+    }
+
+    /// Whether `t` tells that a particle moved more than half the skin
+    /// since the last build.
+    pub fn beyond_skin(&self, t: &Travel, s: &NeighSettings) -> bool {
+        t.built > 0.25 * s.skin * s.skin
+    }
+
+    /// Whether the list is pruned and `t` tells that a pair left out at the
+    /// last prune might touch now.
+    pub fn prune_due(&self, t: &Travel) -> bool {
+        self.outer.is_some() && t.pruned > self.prune_lim
+    }
+
+    /// Whether the list is pruned (the step's check measures
+    /// [`Travel::pruned`] then, whatever `neigh_modify` asks).
+    pub fn pruned(&self) -> bool {
+        !self.x_pruned.is_empty()
     }
 
     /// The answer of a [`Due::Check`] at `step` once `moved` is known over all
@@ -346,11 +473,14 @@ impl PairList {
         F: Fn(usize, usize) -> f64 + Sync,
     {
         let n = p.len();
+        // a pruned list holds every pair with history: the carry reads it
+        // as it reads a full one
+        let listed = self.outer.take().map_or(self.a.len(), |o| o.a.len());
+        self.x_pruned.clear();
         let lens = dom.lengths();
         // the 27 images a cell stencil reaches, indexed by the cell shift
-        let images: Vec<V3> = (0..27)
-            .map(|c: i64| V3::new((c % 3 - 1) as f64 * lens[0], ((c / 3) % 3 - 1) as f64 * lens[1], (c / 9 - 1) as f64 * lens[2]))
-            .collect();
+        let images: Vec<V3> =
+            (0..27).map(|c: i64| V3::new((c % 3 - 1) as f64 * lens[0], ((c / 3) % 3 - 1) as f64 * lens[1], (c / 9 - 1) as f64 * lens[2])).collect();
         let carry = self.carry_source(p, width);
         let mut chunks: Vec<Chunk> = Vec::new();
         if n > 0 {
@@ -364,7 +494,7 @@ impl PairList {
             }
             let emax = rep.iter().flat_map(|&(_, i)| rep.iter().map(move |&(_, j)| (i, j))).map(|(i, j)| extra_range(i, j)).fold(0.0, f64::max);
             let grid = Grid::new(p, dom, 2.0 * rmax + s.skin + emax);
-            let per_particle = self.a.len() / self.x_built.len().max(1);
+            let per_particle = listed / self.x_built.len().max(1);
             let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width, per_particle };
             chunks = in_chunks(n, CHUNK, |r| ctx.chunk(r));
         }
@@ -403,11 +533,168 @@ impl PairList {
         self.images = images;
         self.hist = hist;
         self.width = width;
-        self.index(n);
         self.x_built.clear();
         self.x_built.extend_from_slice(&p.x);
+        self.index(n);
         self.last_build = step;
         self.builds += 1;
+    }
+
+    /// The buffer for a prune at `step`: twice what the fastest particle
+    /// covers in [`PRUNE_STEPS`] steps at the speed the last check measured
+    /// (since the last prune, or the last build while the list is full).
+    pub fn next_buffer(&self, s: &NeighSettings, step: i64) -> f64 {
+        let (d2, since) = if self.pruned() { (self.travel.pruned, step - self.pruned_at) } else { (self.travel.built, step - self.last_build) };
+        let speed = d2.sqrt() / since.max(1) as f64;
+        (2.0 * speed * PRUNE_STEPS).max(PRUNE_MIN * s.skin)
+    }
+
+    /// Keep of the full list the pairs within `buffer` beyond reach
+    /// (touching plus the pair's `extra_range`) at the current positions,
+    /// and every pair with history; or the full list when the buffer is too
+    /// large to pay ([`PRUNE_MAX`]). Then index the pairs.
+    ///
+    /// The owner must then check every step, before the forces, that no
+    /// particle moved half the buffer ([`PairList::travel`],
+    /// [`PairList::prune_due`]) and prune again if one did: so a pair left
+    /// out stays beyond reach, where it would add nothing and keep no
+    /// history.
+    pub fn prune<F: Fn(usize, usize) -> f64>(&mut self, p: &Particles, s: &NeighSettings, buffer: f64, step: i64, extra_range: &F) {
+        let n = p.len();
+        // positions in single precision and their largest rounding error,
+        // which the check's limit leaves room for
+        let mut eps2: f64 = 0.0;
+        let x_pruned: Vec<[f32; 3]> =
+            p.x.iter()
+                .map(|x| {
+                    let q = [x.x as f32, x.y as f32, x.z as f32];
+                    let d = [x.x - q[0] as f64, x.y - q[1] as f64, x.z - q[2] as f64];
+                    eps2 = eps2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    q
+                })
+                .collect();
+        // a relative margin for the rounding of the distances themselves
+        let half = 0.5 * buffer * (1.0 - 1e-9) - eps2.sqrt();
+        let full = buffer >= PRUNE_MAX * s.skin || !(half > 0.0) || n == 0 || NO_PRUNE.with(|u| u.get());
+        if full {
+            if self.outer.is_some() {
+                self.refilter(|_, _, _| true);
+            } else {
+                self.live_from_history();
+            }
+            self.x_pruned.clear();
+        } else {
+            let images = std::mem::take(&mut self.images);
+            self.refilter(|i, j, img| {
+                let d = p.x[i] - (p.x[j] + images[img as usize]);
+                let reach = p.radius[i] + p.radius[j] + extra_range(i, j) + buffer;
+                d.norm_squared() < reach * reach
+            });
+            self.images = images;
+            if self.outer.is_some() {
+                self.x_pruned = x_pruned;
+                self.prune_lim = half * half;
+                self.buffer = buffer;
+                self.pruned_at = step;
+                self.prunes += 1;
+            } else {
+                self.x_pruned.clear();
+            }
+        }
+        // `refilter` set the live flags
+        self.index_blocks(n);
+    }
+
+    /// Keep of the full list (`outer`, or the list itself when full) every
+    /// pair with history and those `near(a, b, image)`, with their history
+    /// and live flags; the list is pruned after unless `near` kept every
+    /// pair.
+    ///
+    /// Two passes without a branch on the pairs' fate, which is a coin toss
+    /// in a bed: the first picks the pairs kept, the second copies them.
+    fn refilter(&mut self, near: impl Fn(usize, usize, u8) -> bool) {
+        let w = self.width;
+        // the pairs the list holds now
+        let inner = self.a.len();
+        let mut outer = match self.outer.take() {
+            Some(o) => o,
+            None => {
+                // a fresh build: its history tells which pairs are live
+                self.live_from_history();
+                let m = self.a.len();
+                let o = Outer {
+                    a: std::mem::take(&mut self.a),
+                    b: std::mem::take(&mut self.b),
+                    image: std::mem::take(&mut self.image),
+                    keys: std::mem::take(&mut self.keys),
+                    inner: (0..m as u32).collect(),
+                    kept: vec![],
+                    from: vec![],
+                };
+                Box::new(o)
+            }
+        };
+        let m = outer.a.len();
+        // one more flag and history for the pairs the list left out: not
+        // live, zero history
+        self.live.truncate(inner);
+        self.live.push(0);
+        self.hist.truncate(inner * w);
+        self.hist.resize((inner + 1) * w, 0.0);
+        let Outer { a, b, image, keys, inner: slot, kept, from } = &mut *outer;
+        // every pair is written at the next place, which moves on when the
+        // pair is kept
+        // (kept from the last prune at their length: no clearing)
+        kept.resize(m, 0);
+        from.resize(m, 0);
+        let mut len = 0;
+        for k in 0..m {
+            let old = (slot[k] as usize).min(inner);
+            // both sides evaluated: no branch
+            let keep = (self.live[old] & 1 != 0) | near(a[k] as usize, b[k] as usize, image[k]);
+            kept[len] = k as u32;
+            from[len] = old as u32;
+            slot[k] = if keep { len as u32 } else { NONE };
+            len += keep as usize;
+        }
+        let (kept, from) = (&kept[..len], &from[..len]);
+        let (live, hist) = (&self.live, &self.hist);
+        let na: Vec<u32> = kept.iter().map(|&k| a[k as usize]).collect();
+        let nb: Vec<u32> = kept.iter().map(|&k| b[k as usize]).collect();
+        let ni: Vec<u8> = kept.iter().map(|&k| image[k as usize]).collect();
+        let nk: Vec<(i64, i64)> = kept.iter().map(|&k| keys[k as usize]).collect();
+        let nl: Vec<u8> = from.iter().map(|&q| live[q as usize]).collect();
+        let mut nh = Vec::with_capacity(len * w);
+        for &q in from {
+            // value by value: a copy of a few values of unknown count would
+            // be a call to memcpy per pair
+            for c in 0..w {
+                nh.push(hist[q as usize * w + c]);
+            }
+        }
+        (self.a, self.b, self.image, self.keys, self.live, self.hist) = (na, nb, ni, nk, nl, nh);
+        if len < m {
+            self.outer = Some(outer);
+        }
+    }
+
+    /// Each pair's live flag from its history (after a build or restart).
+    fn live_from_history(&mut self) {
+        let w = self.width;
+        self.live.clear();
+        self.live.extend((0..self.a.len()).map(|k| self.hist[k * w..(k + 1) * w].iter().any(|&v| v != 0.0) as u8));
+    }
+
+    /// The list with every pair of the last build and its history, as if it
+    /// had not been pruned (for a restart file).
+    pub fn full(&self, n: usize) -> PairList {
+        let mut l = self.clone();
+        if l.outer.is_some() {
+            l.refilter(|_, _, _| true);
+            l.x_pruned.clear();
+            l.index(n);
+        }
+        l
     }
 
     /// Where the next build finds the history of pairs listed now: by storage
@@ -420,9 +707,12 @@ impl PairList {
         }
         let n = p.len();
         let same = self.keys.len() == self.a.len()
-            && self.a.iter().zip(&self.b).zip(&self.keys).all(|((&i, &j), &key)| {
-                (i as usize) < n && (j as usize) < n && (p.tag[i as usize], p.tag[j as usize]) == key
-            });
+            && self
+                .a
+                .iter()
+                .zip(&self.b)
+                .zip(&self.keys)
+                .all(|((&i, &j), &key)| (i as usize) < n && (j as usize) < n && (p.tag[i as usize], p.tag[j as usize]) == key);
         if same {
             let mut start = vec![0u32; n + 1];
             for &i in &self.a {
@@ -454,39 +744,26 @@ impl PairList {
         }
     }
 
-    /// Derived indexes of the pairs `a`, `b` of `n` particles: the adjacency
-    /// of each particle, the pair range of each force block and the cross
-    /// pairs of each particle. Called after every build and after a restart.
+    /// Derived indexes of the pairs `a`, `b` of `n` particles: the live
+    /// flags, the pair range of each force block and the cross pairs of
+    /// each particle. Called after every build, prune and restart.
     pub fn index(&mut self, n: usize) {
+        self.live_from_history();
+        self.index_blocks(n);
+    }
+
+    /// [`PairList::index`] but for the live flags, which are set.
+    fn index_blocks(&mut self, n: usize) {
         let m = self.a.len();
-        let w = self.width;
-        self.live = (0..m).map(|k| self.hist[k * w..(k + 1) * w].iter().any(|&v| v != 0.0) as u8).collect();
-        // adjacency (CSR), pairs in increasing index per particle
-        let mut count = vec![0u32; n + 1];
-        for k in 0..m {
-            count[self.a[k] as usize + 1] += 1;
-            count[self.b[k] as usize + 1] += 1;
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let mut fill = count.clone();
-        self.adj.clear();
-        self.adj.resize(2 * m, 0);
-        for k in 0..m {
-            let a = self.a[k] as usize;
-            let b = self.b[k] as usize;
-            self.adj[fill[a] as usize] = k as u32;
-            fill[a] += 1;
-            self.adj[fill[b] as usize] = k as u32 | ADJ_B;
-            fill[b] += 1;
-        }
-        self.adj_start = count;
         let bs = self.block_size();
         let nblocks = n.div_ceil(bs).max(1);
+        // a particle's block by a shift, not a division (~25 cycles each, a
+        // few per pair: most of this pass's time when a prune calls it)
+        assert!(bs.is_power_of_two(), "force blocks of {bs} particles: not a power of two");
+        let sh = bs.trailing_zeros();
         self.block_start = vec![0; nblocks + 1];
         for k in 0..m {
-            self.block_start[self.a[k] as usize / bs + 1] += 1;
+            self.block_start[(self.a[k] as usize >> sh) + 1] += 1;
         }
         for q in 0..nblocks {
             self.block_start[q + 1] += self.block_start[q];
@@ -500,11 +777,11 @@ impl PairList {
         let mut ncross = 0u32;
         for k in 0..m {
             let (a, b) = (self.a[k] as usize, self.b[k] as usize);
-            if a / bs != b / bs {
+            if a >> sh != b >> sh {
                 ccount[b + 1] += 1;
                 ord[k] = ncross;
                 ncross += 1;
-                self.block_cross[a / bs + 1] += 1;
+                self.block_cross[(a >> sh) + 1] += 1;
             }
         }
         for q in 0..nblocks {
@@ -530,7 +807,7 @@ impl PairList {
         self.xslot = vec![0; ncross as usize];
         self.cross = vec![0; ncross as usize];
         for (c, &k) in by_b.iter().enumerate() {
-            let q = self.a[k as usize] as usize / bs;
+            let q = self.a[k as usize] as usize >> sh;
             self.cross[c] = next[q];
             self.xslot[ord[k as usize] as usize] = next[q] - self.block_cross[q];
             next[q] += 1;
@@ -538,11 +815,43 @@ impl PairList {
         self.cross_start = ccount;
     }
 
+    /// Each particle's pairs in increasing pair index, as CSR offsets per
+    /// particle (n + 1 of them) and pair indices, the high bit ([`ADJ_B`])
+    /// marking pairs where the particle is `b` (for a restart file and
+    /// diagnostics; the force pass does not need it).
+    pub fn adjacency(&self, n: usize) -> (Vec<u32>, Vec<u32>) {
+        let m = self.a.len();
+        let mut start = vec![0u32; n + 1];
+        for k in 0..m {
+            start[self.a[k] as usize + 1] += 1;
+            start[self.b[k] as usize + 1] += 1;
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut adj = vec![0; 2 * m];
+        for k in 0..m {
+            let (a, b) = (self.a[k] as usize, self.b[k] as usize);
+            adj[fill[a] as usize] = k as u32;
+            fill[a] += 1;
+            adj[fill[b] as usize] = k as u32 | ADJ_B;
+            fill[b] += 1;
+        }
+        (start, adj)
+    }
+
+    /// Whether the list is indexed for `n` particles.
+    pub fn indexed(&self, n: usize) -> bool {
+        self.cross_start.len() == n + 1
+    }
+
     /// Atom ids were renumbered (`delete_atoms ... compress yes`; `new_id`
     /// holds the ids that changed): carry the history keys over.
     pub fn retag(&mut self, new_id: &HashMap<i64, i64>) {
         let map = |t: i64| new_id.get(&t).copied().unwrap_or(t);
-        for k in &mut self.keys {
+        let outer = self.outer.iter_mut().flat_map(|o| o.keys.iter_mut());
+        for k in self.keys.iter_mut().chain(outer) {
             *k = (map(k.0), map(k.1));
         }
     }
@@ -592,7 +901,11 @@ pub fn spatial_order(p: &Particles, bin: f64) -> Vec<usize> {
         .map(|i| {
             let c = |d: usize| -> u64 {
                 let k = ((p.x[i][d] - lo[d]) / bin).floor();
-                if k.is_finite() { k.clamp(0.0, 2097151.0) as u64 } else { 0 }
+                if k.is_finite() {
+                    k.clamp(0.0, 2097151.0) as u64
+                } else {
+                    0
+                }
             };
             (spread(c(0)) | spread(c(1)) << 1 | spread(c(2)) << 2, i)
         })
@@ -777,7 +1090,8 @@ mod tests {
                             let s = V3::new(sx as f64 * l[0], sy as f64 * l[1], sz as f64 * l[2]);
                             let d = p.x[i] - (p.x[j] + s);
                             if d.norm() < p.radius[i] + p.radius[j] + skin {
-                                let (ta, tb, sh) = if p.tag[i] <= p.tag[j] { (p.tag[i], p.tag[j], sh) } else { (p.tag[j], p.tag[i], [-sx, -sy, -sz]) };
+                                let (ta, tb, sh) =
+                                    if p.tag[i] <= p.tag[j] { (p.tag[i], p.tag[j], sh) } else { (p.tag[j], p.tag[i], [-sx, -sy, -sz]) };
                                 out.push((ta, tb, sh));
                             }
                         }
@@ -820,11 +1134,80 @@ mod tests {
         assert_eq!(got, brute(&p, &dom, 0.1));
         assert!(!got.is_empty());
         // every pair appears twice in the adjacency, in increasing pair order
-        assert_eq!(pl.adj.len(), 2 * pl.len());
+        let (adj_start, adj) = pl.adjacency(p.len());
+        assert_eq!(adj.len(), 2 * pl.len());
         for i in 0..p.len() {
-            let s = &pl.adj[pl.adj_start[i] as usize..pl.adj_start[i + 1] as usize];
+            let s = &adj[adj_start[i] as usize..adj_start[i + 1] as usize];
             assert!(s.windows(2).all(|w| (w[0] & !ADJ_B) < (w[1] & !ADJ_B)));
         }
+    }
+
+    #[test]
+    fn prune_keeps_pairs_near_and_with_history_and_gives_them_back() {
+        let dom = Domain::new([0.0; 3], [4.0; 3], [[Side::Periodic; 2]; 3], 3);
+        let mut p = Particles::default();
+        let mut s = 3u64;
+        let mut u = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for t in 1..=800 {
+            p.push(part(t, V3::new(4.0 * u(), 4.0 * u(), 4.0 * u()), 0.1 + 0.05 * u()));
+        }
+        let settings = NeighSettings { skin: 0.2, ..Default::default() };
+        let mut pl = PairList::default();
+        pl.build(&p, &dom, &settings, 0, 2, |_, _| 0.0);
+        // history on every 7th pair, touching or not
+        for k in (0..pl.len()).step_by(7) {
+            pl.hist[2 * k + 1] = k as f64 + 1.0;
+        }
+        pl.index(p.len());
+        let full = pl.clone();
+        let near = |k: usize, x: &[V3], buffer: f64| {
+            let (a, b) = (full.a[k] as usize, full.b[k] as usize);
+            (x[a] - (x[b] + full.shift(k))).norm() < p.radius[a] + p.radius[b] + buffer
+        };
+        // the pairs kept, as indices into the full list
+        let kept = |pl: &PairList| -> Vec<usize> { (0..full.len()).filter(|&k| pl.outer.as_ref().unwrap().inner[k] != NONE).collect() };
+        pl.prune(&p, &settings, 0.02, 0, &|_, _| 0.0);
+        let want: Vec<usize> = (0..full.len()).filter(|&k| k % 7 == 0 || near(k, &p.x, 0.02)).collect();
+        assert_eq!(kept(&pl), want);
+        assert!(pl.len() < full.len() / 2, "{} of {} pairs kept", pl.len(), full.len());
+        for (q, &k) in want.iter().enumerate() {
+            assert_eq!((pl.a[q], pl.b[q], pl.image[q], pl.keys[q]), (full.a[k], full.b[k], full.image[k], full.keys[k]));
+            assert_eq!(&pl.hist[2 * q..2 * q + 2], &full.hist[2 * k..2 * k + 2]);
+        }
+        assert_eq!(pl.prunes, 1);
+        assert!(pl.pruned() && pl.indexed(p.len()));
+        // the force pass changes history: a pair touching now gets some, and
+        // every 7th loses its own (as pairs that came apart do)
+        for q in 0..pl.len() {
+            pl.hist[2 * q] = if pl.hist[2 * q + 1] != 0.0 { 0.0 } else { 1.0 + q as f64 };
+            pl.hist[2 * q + 1] = 0.0;
+        }
+        pl.index(p.len());
+        let after: Vec<f64> = pl.hist.clone();
+        let was = kept(&pl);
+        // particles move; a prune with a wider buffer keeps pairs with history
+        for x in p.x.iter_mut() {
+            *x += V3::new(0.01, -0.005, 0.003);
+        }
+        pl.prune(&p, &settings, 0.05, 5, &|_, _| 0.0);
+        let live = |k: usize| was.iter().position(|&j| j == k).is_some_and(|q| after[2 * q] != 0.0);
+        let want: Vec<usize> = (0..full.len()).filter(|&k| live(k) || near(k, &p.x, 0.05)).collect();
+        assert_eq!(kept(&pl), want);
+        // and the full list comes back with each pair's latest history
+        let back = pl.full(p.len());
+        assert!(back.outer.is_none() && !back.pruned());
+        assert_eq!((&back.a, &back.b, &back.image, &back.keys), (&full.a, &full.b, &full.image, &full.keys));
+        for k in 0..full.len() {
+            let h = was.iter().position(|&j| j == k).map_or([0.0, 0.0], |q| [after[2 * q], after[2 * q + 1]]);
+            assert_eq!(&back.hist[2 * k..2 * k + 2], &h, "pair {k}");
+        }
+        // a buffer of half the skin or more keeps the full list
+        pl.prune(&p, &settings, 0.1, 6, &|_, _| 0.0);
+        assert!(pl.outer.is_none() && !pl.pruned());
+        assert_eq!(pl.hist, back.hist);
     }
 
     #[test]

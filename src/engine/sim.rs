@@ -4,7 +4,7 @@ use super::compute::Compute;
 use super::domain::Domain;
 use super::fix::{Chunk, Fix, Hole, Hook, Local, Stage};
 use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable};
-use super::neighbor::{Due, NeighSettings, PairList};
+use super::neighbor::{Due, NeighSettings, PairList, Travel};
 use super::output::{Dump, Logger, Thermo};
 use super::particles::Particles;
 use crate::error::{Error, Result};
@@ -231,6 +231,8 @@ impl Sim {
             }
         }
         let width = self.model.as_ref().map_or(0, |m| m.kernel.history_width());
+        // chosen from the travel since the last build or prune, before the build
+        let buffer = self.pairs.next_buffer(&self.neigh, self.step);
         let table = self.model.as_ref().map(|m| &m.table);
         let p = &self.particles;
         let dom = self.domain.as_ref().ok_or_else(|| Error::runtime("no box"))?;
@@ -246,8 +248,22 @@ impl Sim {
                 self.pairs.index(p.len());
             }
         }
+        self.prune(buffer);
         self.force_rebuild = false;
         Ok(())
+    }
+
+    /// Prune the pair list from its last build ([`PairList::prune`]) with
+    /// `buffer`; `one_step` checks the travel against it.
+    fn prune(&mut self, buffer: f64) {
+        let Some(m) = &self.model else { return };
+        let (t, p, step) = (&m.table, &self.particles, self.step);
+        if t.max_extra_range() > 0.0 {
+            let kinds = &p.kind;
+            self.pairs.prune(p, &self.neigh, buffer, step, &|i: usize, j: usize| t.get(kinds[i], kinds[j]).extra_range)
+        } else {
+            self.pairs.prune(p, &self.neigh, buffer, step, &|_: usize, _: usize| 0.0)
+        }
     }
 
     /// Clear forces and compute pair forces.
@@ -336,10 +352,10 @@ impl Sim {
     }
 
     /// One step. `carried`: the previous step's tail already ran this
-    /// step's head (and advanced the clock), which gave this answer of the
-    /// skin check. Returns the same for the next step when this step's tail
-    /// runs its head ([`Sim::fuse_next`]).
-    fn one_step(&mut self, vars: &Variables, carried: Option<bool>) -> Result<Option<bool>> {
+    /// step's head (and advanced the clock), which measured this travel.
+    /// Returns the same for the next step when this step's tail runs its
+    /// head ([`Sim::fuse_next`]).
+    fn one_step(&mut self, vars: &Variables, carried: Option<Travel>) -> Result<Option<Travel>> {
         let t = Instant::now();
         let (moved, due) = match carried {
             Some(moved) => (moved, self.due()),
@@ -357,11 +373,14 @@ impl Sim {
             || match due {
                 Due::Build => true,
                 Due::Skip => false,
-                Due::Check => self.pairs.checked(moved, &self.neigh, step),
+                Due::Check => self.pairs.checked(self.pairs.beyond_skin(&moved, &self.neigh), &self.neigh, step),
             };
+        self.pairs.travel = moved;
         if build {
             self.each_fix(|f, s| f.pre_exchange(s, vars))?;
             self.rebuild()?;
+        } else if self.pairs.prune_due(&moved) {
+            self.prune(self.pairs.next_buffer(&self.neigh, step));
         }
         let tn = t.elapsed().as_secs_f64();
         let t = Instant::now();
@@ -385,9 +404,9 @@ impl Sim {
             // in the same order, so the bits are those of two passes)
             let due = self.advance();
             self.hooks(&[Hook::InitialIntegrate], vars, &mut gather, &mut stages)?;
-            Some(self.fused(&mut stages, gather, due == Due::Check))
+            Some(self.fused(&mut stages, gather, Some(due == Due::Check)))
         } else {
-            self.fused(&mut stages, gather, false);
+            self.fused(&mut stages, gather, None);
             self.each_fix(|f, s| f.end_of_step(s, vars))?;
             if self.guard.due(self.step) {
                 super::guard::check(self, false)?;
@@ -437,18 +456,19 @@ impl Sim {
     }
 
     /// The step's head: every fix's initial_integrate, fused chunk by chunk
-    /// where the fixes act particle by particle (as the tail); with
-    /// `check`, the same pass then tells whether a particle moved more than
-    /// half the skin since the last build ([`PairList::moved`]), over the
-    /// positions after every fix's initial_integrate.
-    fn head(&mut self, vars: &Variables, check: bool) -> Result<bool> {
+    /// where the fixes act particle by particle (as the tail); the same
+    /// pass then measures how far the particles moved ([`PairList::travel`]:
+    /// since the last build with `check`, since the last prune while the
+    /// list is pruned), at the positions after every fix's
+    /// initial_integrate.
+    fn head(&mut self, vars: &Variables, check: bool) -> Result<Travel> {
         let mut stages = vec![];
         self.hooks(&[Hook::InitialIntegrate], vars, &mut false, &mut stages)?;
         if UNFUSED.with(|u| u.get()) {
             // the check on its own, as tests compare
-            return Ok(check && self.pairs.moved_any(&self.particles.x, &self.neigh));
+            return Ok(self.pairs.travel_all(&self.particles.x, check));
         }
-        Ok(self.fused(&mut stages, false, check))
+        Ok(self.fused(&mut stages, false, Some(check)))
     }
 
     /// Every fix's `hooks`, in order: a fix's stage joins the pending
@@ -462,7 +482,7 @@ impl Sim {
                 let local = if fuse { fix.local(hook, self, vars) } else { Ok(Local::Whole) };
                 let local = match local {
                     Ok(Local::Whole) => {
-                        self.fused(stages, std::mem::take(gather), false);
+                        self.fused(stages, std::mem::take(gather), None);
                         match hook {
                             Hook::PostForce => fix.post_force(self, vars).map(|_| Local::Nothing),
                             Hook::InitialIntegrate => {
@@ -486,20 +506,25 @@ impl Sim {
         Ok(())
     }
 
-    /// Run the cross pass (when `gather`), then `stages`, then the skin check
-    /// (when `check`; its answer is returned) over the particles in fixed
-    /// chunks, in parallel from two chunks up; empties `stages`.
-    fn fused(&mut self, stages: &mut Vec<Box<dyn Stage>>, gather: bool, check: bool) -> bool {
-        if stages.is_empty() && !gather && !check {
-            return false;
+    /// Run the cross pass (when `gather`), then `stages`, then, with
+    /// `Some(check)`, measure the travel (since the last build when
+    /// `check`, since the last prune while the list is pruned; returned)
+    /// over the particles in fixed chunks, in parallel from two chunks up;
+    /// empties `stages`.
+    fn fused(&mut self, stages: &mut Vec<Box<dyn Stage>>, gather: bool, measure: Option<bool>) -> Travel {
+        let check = measure == Some(true);
+        let measure = check || (measure.is_some() && self.pairs.pruned());
+        if stages.is_empty() && !gather && !measure {
+            return Travel::default();
         }
         let cross = gather && !self.pairs.cross.is_empty();
-        let (pairs, defer, neigh) = (&self.pairs, &self.pair_defer[..], &self.neigh);
+        let (pairs, defer) = (&self.pairs, &self.pair_defer[..]);
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, .. } = &mut self.particles;
         let n = x.len();
         let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
         // each extra column cut at the chunks
-        let mut cols: Vec<std::slice::ChunksMut<'_, f64>> = extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(TAIL_CHUNK * e.width.max(1))).collect();
+        let mut cols: Vec<std::slice::ChunksMut<'_, f64>> =
+            extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(TAIL_CHUNK * e.width.max(1))).collect();
         let jobs: Vec<Chunk<'_>> = x
             .chunks_mut(TAIL_CHUNK)
             .zip(v.chunks_mut(TAIL_CHUNK))
@@ -522,21 +547,25 @@ impl Sim {
             })
             .collect();
         let pending = &*stages;
-        let run = |mut c: Chunk<'_>| -> bool {
+        let run = |mut c: Chunk<'_>| -> Travel {
             if cross {
                 cross_gather_chunk(pairs, defer, c.lo, c.f, c.torque);
             }
             for st in pending {
                 st.apply(&mut c);
             }
-            check && pairs.moved(c.x, c.lo, neigh)
+            if measure {
+                pairs.travel(c.x, c.lo, check)
+            } else {
+                Travel::default()
+            }
         };
-        // a yes/no over the chunks: the same on any thread count
+        // maxima over the chunks: the same on any thread count
         let moved = if jobs.len() > 1 {
             use rayon::prelude::*;
-            jobs.into_par_iter().map(run).reduce(|| false, |a, b| a | b)
+            jobs.into_par_iter().map(run).reduce(Travel::default, Travel::max)
         } else {
-            jobs.into_iter().fold(false, |a, c| a | run(c))
+            jobs.into_iter().fold(Travel::default(), |a, c| a.max(run(c)))
         };
         stages.clear();
         moved
@@ -578,6 +607,9 @@ impl Sim {
         let ps = if secs > 0.0 { np as f64 * n as f64 / secs } else { 0.0 };
         s.push_str(&format!("\nPerformance: {:.4e} particle-steps/s, {:.1} steps/s\n", ps, if secs > 0.0 { n as f64 / secs } else { 0.0 }));
         s.push_str(&format!("Neighbor list builds = {}\nDangerous builds = {}\n", self.pairs.builds, self.pairs.dangerous));
+        if self.pairs.prunes > 0 {
+            s.push_str(&format!("Pair list prunes = {} (last buffer {:.3e})\n", self.pairs.prunes, self.pairs.buffer));
+        }
         s
     }
 

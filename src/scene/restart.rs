@@ -87,6 +87,10 @@ impl RestartState {
     pub fn of(sim: &Sim, replay: Vec<String>) -> Result<RestartState> {
         let d = sim.domain.as_ref().ok_or_else(|| Error::runtime("write_restart before the box exists"))?;
         let p = &sim.particles;
+        // the list as if it had not been pruned: the resumed run need not
+        // know the prune
+        let pairs = sim.pairs.full(p.len());
+        let (adj_start, adj) = pairs.adjacency(p.len());
         let sides: String = d.sides.iter().flat_map(|s| [s[0].letter(), s[1].letter()]).collect();
         Ok(RestartState {
             format: FORMAT.into(),
@@ -116,17 +120,17 @@ impl RestartState {
             extra: p.extra.iter().map(|e| Extra { name: e.name.clone(), width: e.width, data: e.data.clone(), default: e.default.clone() }).collect(),
             f: p.f.iter().map(v3).collect(),
             torque: p.torque.iter().map(v3).collect(),
-            pair_keys: sim.pairs.keys.clone(),
-            pair_hist: sim.pairs.hist.clone(),
-            pair_width: sim.pairs.width,
-            pair_a: sim.pairs.a.clone(),
-            pair_b: sim.pairs.b.clone(),
-            pair_shift: (0..sim.pairs.len()).map(|k| v3(&sim.pairs.shift(k))).collect(),
-            adj_start: sim.pairs.adj_start.clone(),
-            adj: sim.pairs.adj.clone(),
-            x_built: sim.pairs.x_built.iter().map(v3).collect(),
-            last_build: sim.pairs.last_build,
-            builds: sim.pairs.builds,
+            pair_keys: pairs.keys.clone(),
+            pair_hist: pairs.hist.clone(),
+            pair_width: pairs.width,
+            pair_a: pairs.a.clone(),
+            pair_b: pairs.b.clone(),
+            pair_shift: (0..pairs.len()).map(|k| v3(&pairs.shift(k))).collect(),
+            adj_start,
+            adj,
+            x_built: pairs.x_built.iter().map(v3).collect(),
+            last_build: pairs.last_build,
+            builds: pairs.builds,
             replay,
         })
     }
@@ -149,7 +153,9 @@ impl RestartState {
     pub fn read(path: &Path) -> std::result::Result<RestartState, String> {
         let f = std::fs::File::open(path).map_err(|e| e.to_string())?;
         let st: RestartState = serde_json::from_reader(std::io::BufReader::new(f)).map_err(|e| {
-            format!("not a demx restart file ({e}); demx reads only restart files written by demx (binary LAMMPS/LIGGGHTS restarts are engine-specific)")
+            format!(
+                "not a demx restart file ({e}); demx reads only restart files written by demx (binary LAMMPS/LIGGGHTS restarts are engine-specific)"
+            )
         })?;
         if st.format != FORMAT {
             return Err(format!("restart format '{}' (expected {FORMAT})", st.format));
@@ -160,9 +166,20 @@ impl RestartState {
     /// Put the state into a simulation (replacing particles and box).
     pub fn apply(self, sim: &mut Sim) -> std::result::Result<(), String> {
         let n = self.tag.len();
-        let ok = [self.kind.len(), self.mask.len(), self.x.len(), self.v.len(), self.omega.len(), self.radius.len(), self.mass.len(), self.density.len(), self.image.len(), self.frozen.len()]
-            .iter()
-            .all(|&l| l == n);
+        let ok = [
+            self.kind.len(),
+            self.mask.len(),
+            self.x.len(),
+            self.v.len(),
+            self.omega.len(),
+            self.radius.len(),
+            self.mass.len(),
+            self.density.len(),
+            self.image.len(),
+            self.frozen.len(),
+        ]
+        .iter()
+        .all(|&l| l == n);
         if !ok || self.sides.len() != 6 {
             return Err("restart file is inconsistent (column lengths differ)".into());
         }
@@ -225,8 +242,6 @@ impl RestartState {
             b: self.pair_b,
             hist: self.pair_hist,
             width: self.pair_width,
-            adj_start: self.adj_start,
-            adj: self.adj,
             keys: self.pair_keys,
             x_built: self.x_built.iter().map(a3).collect(),
             last_build: self.last_build,
@@ -368,7 +383,8 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                 atoms,
                 has_velocities: true,
             };
-            let engine = if s.sim.dialect == crate::engine::Dialect::Liggghts { crate::io::dump::Engine::Liggghts } else { crate::io::dump::Engine::Lammps };
+            let engine =
+                if s.sim.dialect == crate::engine::Dialect::Liggghts { crate::io::dump::Engine::Liggghts } else { crate::io::dump::Engine::Lammps };
             crate::io::data::write_data(&w.text, &df, engine, s.sim.step.max(0) as u64)
         }
         _ => unreachable!("restart::execute dispatched a command it does not handle"),
@@ -455,46 +471,21 @@ mod tests {
         for k in 0..n {
             // mantissas of all kinds, scales from 1e-9 to 1e3
             let s = 10f64.powi((k % 13) as i32 - 9);
-            let x = V3::new(
-                rng.uniform() * s,
-                rng.uniform() * s,
-                (rng.uniform() - 0.5) * s,
-            );
-            sim.particles.push(NewParticle {
-                tag: k as i64 + 1,
-                kind: 1,
-                mask: 1,
-                x,
-                v: x * 3.7,
-                omega: x * -1.3,
-                radius: 1e-3,
-                density: 2500.0,
-            });
+            let x = V3::new(rng.uniform() * s, rng.uniform() * s, (rng.uniform() - 0.5) * s);
+            sim.particles.push(NewParticle { tag: k as i64 + 1, kind: 1, mask: 1, x, v: x * 3.7, omega: x * -1.3, radius: 1e-3, density: 2500.0 });
         }
         sim.pairs.index(n);
         sim.pairs.x_built = sim.particles.x.clone();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("restart.1");
-        RestartState::of(&sim, vec![])
-            .unwrap()
-            .write(&path)
-            .unwrap();
+        RestartState::of(&sim, vec![]).unwrap().write(&path).unwrap();
         let mut back = Sim::default();
         RestartState::read(&path).unwrap().apply(&mut back).unwrap();
         let bits = |p: &crate::engine::particles::Particles| -> Vec<u64> {
-            p.x.iter()
-                .chain(&p.v)
-                .chain(&p.omega)
-                .flat_map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()])
-                .collect()
+            p.x.iter().chain(&p.v).chain(&p.omega).flat_map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]).collect()
         };
         let (a, b) = (bits(&sim.particles), bits(&back.particles));
         let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
-        assert_eq!(
-            differ,
-            0,
-            "{differ} of {} values changed in the round trip",
-            a.len()
-        );
+        assert_eq!(differ, 0, "{differ} of {} values changed in the round trip", a.len());
     }
 }
