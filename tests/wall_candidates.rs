@@ -8,7 +8,14 @@
 //! one chunk of candidates) must write the same dump bytes as the run with
 //! `neigh_modify check no`, which rebuilds every step and so tries every
 //! particle against the wall every step.
+//!
+//! The same fall checks the wall's batches: the floor's contacts run on
+//! lanes, eight at a time (`ContactKernel::wall_contacts`), and must give
+//! the bits of the contact-by-contact laws, with LIGGGHTS Hertz, history and
+//! epsd2, and with the paper's model on the wall.
 
+use demx::cli::{run_deck, DeckArgs};
+use demx::engine::kernel::with_scalar_pass;
 use std::process::Command;
 
 /// 71 x 71 spheres of 1 mm, 3 mm apart, 0.6-3.6 mm above the floor.
@@ -30,19 +37,30 @@ fn data() -> String {
     s
 }
 
-fn deck(neigh: &str) -> String {
+const STOCK: &str = "pair_style gran model hertz tangential history rolling_friction epsd2\npair_coeff * *\n\
+    fix floor all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 1 zplane 0.0\n";
+
+/// The paper's model (templates/heap, model paper); the wall has no
+/// cohesion.
+const PAPER: &str = "fix m6 all property/global restitutionReferenceVelocity scalar 1.0\n\
+    fix m7 all property/global surfaceEnergy peratomtypepair 1 0.05\n\
+    fix m8 all property/global vdwMinDistance scalar 1.65e-10\nfix m9 all property/global vdwCutoff scalar 1e-5\n\
+    pair_style gran model hertz/viscoelastic tangential history/paper cohesion vdw rolling_friction epsd/paper\npair_coeff * *\n\
+    fix floor all wall/gran model hertz/viscoelastic tangential history/paper rolling_friction epsd/paper primitive type 1 zplane 0.0\n";
+
+/// The deck, reading and writing in `dir`.
+fn deck(neigh: &str, model: &str, dir: &str) -> String {
     format!(
         "atom_style granular\natom_modify map array\nboundary p p f\nnewton off\ncommunicate single vel yes\nunits si\n\
-         read_data data.spheres\n{neigh}\n\
+         read_data {dir}/data.spheres\n{neigh}\n\
          fix m1 all property/global youngsModulus peratomtype 1.e7\n\
          fix m2 all property/global poissonsRatio peratomtype 0.3\n\
          fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
          fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
          fix m5 all property/global coefficientRollingFriction peratomtypepair 1 0.1\n\
-         pair_style gran model hertz tangential history rolling_friction epsd2\npair_coeff * *\ntimestep 5e-6\n\
-         fix floor all wall/gran model hertz tangential history rolling_friction epsd2 primitive type 1 zplane 0.0\n\
+         {model}timestep 5e-6\n\
          fix grav all gravity 9.81 vector 0.0 0.0 -1.0\nfix integr all nve/sphere\n\
-         dump d all custom 500 dump.spheres id x y z vx vy vz omegax omegay omegaz\n\
+         dump d all custom 500 {dir}/dump.spheres id x y z vx vy vz omegax omegay omegaz\n\
          dump_modify d sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\"\n\
          run 6000\n"
     )
@@ -52,7 +70,7 @@ fn deck(neigh: &str) -> String {
 fn run(neigh: &str, threads: usize) -> (Vec<u8>, u64) {
     let dir = tempfile::tempdir().expect("tempdir");
     std::fs::write(dir.path().join("data.spheres"), data()).unwrap();
-    std::fs::write(dir.path().join("in.spheres"), deck(neigh)).unwrap();
+    std::fs::write(dir.path().join("in.spheres"), deck(neigh, STOCK, ".")).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_demx"))
         .current_dir(dir.path())
         .args(["run", "--log", "none", "--threads", &threads.to_string(), "in.spheres"])
@@ -85,4 +103,45 @@ fn wall_candidates_change_no_bit() {
         let line = every[..at].iter().filter(|&&c| c == b'\n').count() + 1;
         panic!("wall candidates changed the dump from line {line}");
     }
+}
+
+/// The dump of the fall on 2 threads, in process, with the wall's contacts
+/// (and the pairs') on lanes or one by one.
+fn run_in_process(model: &str, scalar: bool) -> Vec<u8> {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path().to_str().unwrap().to_string();
+    std::fs::write(dir.path().join("data.spheres"), data()).unwrap();
+    std::fs::write(dir.path().join("in.spheres"), deck("neighbor 0.0005 bin\nneigh_modify delay 0", model, &d)).unwrap();
+    let args = DeckArgs { deck: dir.path().join("in.spheres"), var: vec![], perturb: None, var_groups: vec![] };
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let go = || run_deck(&args, false, 2, None, true, None, Default::default()).2;
+    let r = pool.install(|| if scalar { with_scalar_pass(go) } else { go() });
+    assert!(r.is_ok(), "demx failed: {:?}", r.err());
+    std::fs::read(dir.path().join("dump.spheres")).expect("dump written")
+}
+
+fn lanes_change_no_bit(model: &str, what: &str) {
+    let lanes = run_in_process(model, false);
+    let one = run_in_process(model, true);
+    // many spheres (radius 0.5 mm) press into the floor at once in some
+    // frame: the batches were full
+    let text = String::from_utf8_lossy(&lanes);
+    let touching = |frame: &str| frame.lines().skip(1).filter(|l| l.split_whitespace().nth(3).and_then(|z| z.parse::<f64>().ok()).is_some_and(|z| z < 0.0005)).count();
+    let most = text.split("ITEM: ATOMS").skip(1).map(touching).max().unwrap_or(0);
+    assert!(most > 50, "{what}: at most {most} spheres touch the floor at once");
+    if lanes != one {
+        let at = lanes.iter().zip(&one).position(|(a, b)| a != b).unwrap_or(lanes.len().min(one.len()));
+        let line = lanes[..at].iter().filter(|&&c| c == b'\n').count() + 1;
+        panic!("{what}: the wall's contacts on lanes changed the dump from line {line}");
+    }
+}
+
+#[test]
+fn wall_contacts_on_lanes_change_no_bit() {
+    lanes_change_no_bit(STOCK, "hertz/history/epsd2");
+}
+
+#[test]
+fn wall_contacts_on_lanes_change_no_bit_with_the_paper_model() {
+    lanes_change_no_bit(PAPER, "paper model");
 }

@@ -81,6 +81,13 @@ pub trait ContactKernel: Send + Sync {
     /// One contact with a wall or any other partner given as a `Contact`;
     /// history is zeroed when apart. Returns the laws' output.
     fn contact(&self, c: &Contact, params: &PairParams, hist: &mut [f64]) -> ContactOut;
+    /// Up to [`LANES`] contacts with walls at one time step, touching
+    /// (`delta > 0`) unless the normal law acts beyond touching (JKR): contact `k` has coefficients `params[k]`, history
+    /// `hist[k * w..(k + 1) * w]` (`w` the history width) and its output
+    /// goes to `out[k]`. The laws run on lanes where they have a lane form,
+    /// else contact by contact; each output has the bits
+    /// [`ContactKernel::contact`] gives.
+    fn wall_contacts(&self, cs: &[Contact], params: &[&PairParams], hist: &mut [f64], out: &mut [ContactOut]);
 }
 
 impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C, R> {
@@ -261,6 +268,37 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
     }
     fn contact(&self, c: &Contact, params: &PairParams, hist: &mut [f64]) -> ContactOut {
         self.apply(c, params, hist)
+    }
+    fn wall_contacts(&self, cs: &[Contact], params: &[&PairParams], hist: &mut [f64], out: &mut [ContactOut]) {
+        let (w, count) = (Self::WIDTH, cs.len());
+        debug_assert!(count <= LANES && params.len() == count && hist.len() == count * w && out.len() == count);
+        debug_assert!(cs.iter().all(|c| c.is_wall() && (c.delta > 0.0 || !Self::BATCHED) && c.dt == cs[0].dt));
+        if !Self::BATCHED || count < 2 || self.scalar_only() {
+            for (k, c) in cs.iter().enumerate() {
+                out[k] = self.apply(c, params[k], &mut hist[k * w..(k + 1) * w]);
+            }
+            return;
+        }
+        // every lane touches: `apply_lanes` gives each the bits of `apply`
+        // (lanes past `count` repeat the last contact and are dropped)
+        let c = ContactL::<F8>::gather(cs);
+        let mut coeffs = BatchCoeffs { p: [params[0]; LANES], uniform: true };
+        let mut lanes = [F8::splat(0.0); MAX_BATCH_HISTORY];
+        for l in 0..LANES {
+            let k = l.min(count - 1);
+            coeffs.p[l] = params[k];
+            coeffs.uniform &= std::ptr::eq(params[k], params[0]);
+            for (m, v) in hist[k * w..(k + 1) * w].iter().enumerate() {
+                lanes[m].0[l] = *v;
+            }
+        }
+        let o = self.apply_lanes(&c, &coeffs, &mut lanes[..w]);
+        for k in 0..count {
+            for (m, v) in hist[k * w..(k + 1) * w].iter_mut().enumerate() {
+                *v = lanes[m].0[k];
+            }
+            out[k] = o.lane(k);
+        }
     }
     fn force_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, force: Forces<'_>) -> f64 {
         let m = pairs.len();

@@ -290,7 +290,7 @@ impl RollingLaw for NoRolling {
 
 /// [`Contact`] on lanes: one contact (`R = f64`) or a batch of pair contacts
 /// ([`lanes::F8`]). Same fields and conventions; `wall` is one flag for all
-/// lanes (batches hold pairs only).
+/// lanes (a batch holds pairs, or contacts with walls).
 #[derive(Clone, Copy, Debug)]
 pub struct ContactL<R> {
     /// Unit normal from j to i.
@@ -354,6 +354,57 @@ impl ContactL<f64> {
     #[inline(always)]
     pub fn one(c: &Contact) -> Self {
         convert_contact!(c, ContactL { wall: c.is_wall() })
+    }
+}
+
+impl ContactL<lanes::F8> {
+    /// Up to [`lanes::LANES`] contacts, one per lane (lanes past `cs.len()`
+    /// repeat the last contact), all with the same `wall` flag and time step
+    /// (those of `cs[0]`). `cs` must not be empty.
+    #[inline(always)]
+    pub fn gather(cs: &[Contact]) -> Self {
+        use lanes::{F8, LANES};
+        let z = F8::splat(0.0);
+        let zv = Vec3::zeros();
+        let mut l = ContactL {
+            n: zv,
+            r: z,
+            delta: z,
+            ri: z,
+            rj: z,
+            r_eff: z,
+            mi: z,
+            mj: z,
+            m_eff: z,
+            vr: zv,
+            vn: z,
+            wi: zv,
+            wj: zv,
+            dt: cs[0].dt,
+            wall: cs[0].is_wall(),
+        };
+        let put = |v: &mut Vec3<F8>, k: usize, x: &V3| {
+            v.x.0[k] = x.x;
+            v.y.0[k] = x.y;
+            v.z.0[k] = x.z;
+        };
+        for k in 0..LANES {
+            let c = &cs[k.min(cs.len() - 1)];
+            put(&mut l.n, k, &c.n);
+            put(&mut l.vr, k, &c.vr);
+            put(&mut l.wi, k, &c.wi);
+            put(&mut l.wj, k, &c.wj);
+            l.r.0[k] = c.r;
+            l.delta.0[k] = c.delta;
+            l.ri.0[k] = c.ri;
+            l.rj.0[k] = c.rj;
+            l.r_eff.0[k] = c.r_eff;
+            l.mi.0[k] = c.mi;
+            l.mj.0[k] = c.mj;
+            l.m_eff.0[k] = c.m_eff;
+            l.vn.0[k] = c.vn;
+        }
+        l
     }
 }
 
@@ -452,6 +503,27 @@ macro_rules! convert_out {
             torque_j: $o.torque_j.into(),
         }
     };
+}
+
+impl OutL<lanes::F8> {
+    /// Lane `l` as one contact's output.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> ContactOut {
+        ContactOut {
+            fn_elastic: self.fn_elastic.0[l],
+            fn_damp: self.fn_damp.0[l],
+            fn_coh: self.fn_coh.0[l],
+            fn_for_friction: self.fn_for_friction.0[l],
+            kn: self.kn.0[l],
+            kt: self.kt.0[l],
+            a: self.a.0[l],
+            gamma_n: self.gamma_n.0[l],
+            gamma_t: self.gamma_t.0[l],
+            ft: self.ft.lane(l),
+            torque_i: self.torque_i.lane(l),
+            torque_j: self.torque_j.lane(l),
+        }
+    }
 }
 
 impl From<&ContactOut> for OutL<f64> {

@@ -13,7 +13,8 @@ use crate::error::{Error, Result};
 use crate::geom::{PrimitiveWall, WallMotion};
 use crate::physics::normal::granular::{GranularDamping, GranularNormal};
 use crate::physics::normal::jkr::jkr_pulloff_overlap;
-use crate::physics::{Contact, V3};
+use crate::physics::lanes::LANES;
+use crate::physics::{Contact, ContactOut, PairParams, V3};
 use crate::script::{Command, Variables, Word};
 use crate::engine::integrate::CHUNK;
 use rayon::prelude::*;
@@ -55,14 +56,29 @@ struct Sphere {
     mask: u32,
 }
 
+/// What the wall finds for one particle.
+enum Meet<'t> {
+    /// No contact (history cleared); whether within reach + margin.
+    Apart(bool),
+    /// A contact for the laws, with its coefficients.
+    Touch(Contact, &'t PairParams),
+}
+
+/// Contacts of one chunk waiting to run as one batch: chunk positions,
+/// contacts and coefficients, `n` of them.
+struct Batch<'t> {
+    q: [usize; LANES],
+    c: [Contact; LANES],
+    pp: [&'t PairParams; LANES],
+    n: usize,
+}
+
 impl WallLaws {
-    /// The wall's contact with particle `s`, added to its force `fi` and
-    /// torque `ti`; with `margin`, whether it is within reach + margin of
-    /// the wall.
+    /// The wall's contact with particle `s`: clears `hist` when apart.
     #[inline(always)]
-    fn touch(&self, fr: &WallFrame, s: &Sphere, fi: &mut V3, ti: &mut V3, hist: &mut [f64], margin: Option<f64>) -> bool {
+    fn meet(&self, fr: &WallFrame, s: &Sphere, hist: &mut [f64], margin: Option<f64>) -> Meet<'_> {
         if s.mask & self.group == 0 {
-            return false;
+            return Meet::Apart(false);
         }
         let ri = s.radius;
         let pp = self.table.get(s.kind, self.wall_type);
@@ -73,12 +89,12 @@ impl WallLaws {
         let near = margin.is_some_and(|m| self.wall.contact(s.x, ri + reach + m, fr.shift).is_some());
         let Some((delta, n, _pt)) = self.wall.contact(s.x, ri + reach, fr.shift) else {
             clear(hist);
-            return near;
+            return Meet::Apart(near);
         };
         let delta = delta - reach;
         if delta <= 0.0 && !self.jkr {
             clear(hist);
-            return near;
+            return Meet::Apart(near);
         }
         // LAMMPS zcylinder: the wall's curvature enters R* through
         // rwall = -2 R_c (met from inside) or +2 R_c (outside)
@@ -108,10 +124,67 @@ impl WallLaws {
             wj: V3::zeros(),
             dt: fr.dt,
         };
-        let out = self.kernel.contact(&c, pp, &mut hist[..self.width]);
-        *fi += out.force_i(&c);
-        *ti += out.torque_i;
-        true
+        Meet::Touch(c, pp)
+    }
+
+    /// The wall's contacts with the particles at chunk positions `qs`
+    /// (increasing; `sphere(q)` reads one), adding to the chunk's forces
+    /// `f`, torques `t` and history rows `h`. Contacts are gathered into
+    /// batches of [`LANES`] for the kernel ([`ContactKernel::wall_contacts`]);
+    /// each particle meets the wall once, so its sums are those of one
+    /// contact at a time. With `margin`, `near(q)` hears of every particle
+    /// within reach + margin of the wall.
+    #[allow(clippy::too_many_arguments)]
+    fn touch_chunk(
+        &self,
+        fr: &WallFrame,
+        qs: impl Iterator<Item = usize>,
+        sphere: impl Fn(usize) -> Sphere,
+        f: &mut [V3],
+        t: &mut [V3],
+        h: &mut [f64],
+        margin: Option<f64>,
+        mut near: impl FnMut(usize),
+    ) {
+        let wc = self.width.max(1);
+        let mut scratch = vec![0.0; LANES * self.width];
+        let z = Contact { n: V3::zeros(), r: 0.0, delta: 0.0, ri: 0.0, rj: 0.0, r_eff: 0.0, mi: 0.0, mj: 0.0, m_eff: 0.0, vr: V3::zeros(), vn: 0.0, wi: V3::zeros(), wj: V3::zeros(), dt: 0.0 };
+        let p0 = self.table.get(1, self.wall_type);
+        let mut b = Batch { q: [0; LANES], c: [z; LANES], pp: [p0; LANES], n: 0 };
+        for q in qs {
+            match self.meet(fr, &sphere(q), &mut h[q * wc..(q + 1) * wc], margin) {
+                Meet::Apart(true) => near(q),
+                Meet::Apart(false) => {}
+                Meet::Touch(c, pp) => {
+                    near(q);
+                    (b.q[b.n], b.c[b.n], b.pp[b.n]) = (q, c, pp);
+                    b.n += 1;
+                    if b.n == LANES {
+                        self.run(&mut b, &mut scratch, f, t, h);
+                    }
+                }
+            }
+        }
+        if b.n > 0 {
+            self.run(&mut b, &mut scratch, f, t, h);
+        }
+    }
+
+    /// Run batch `b` and empty it.
+    fn run(&self, b: &mut Batch<'_>, scratch: &mut [f64], f: &mut [V3], t: &mut [V3], h: &mut [f64]) {
+        let (w, wc, n) = (self.width, self.width.max(1), b.n);
+        for k in 0..n {
+            scratch[k * w..(k + 1) * w].copy_from_slice(&h[b.q[k] * wc..b.q[k] * wc + w]);
+        }
+        let mut out = [ContactOut::default(); LANES];
+        self.kernel.wall_contacts(&b.c[..n], &b.pp[..n], &mut scratch[..n * w], &mut out[..n]);
+        for k in 0..n {
+            let q = b.q[k];
+            h[q * wc..q * wc + w].copy_from_slice(&scratch[k * w..(k + 1) * w]);
+            f[q] += out[k].force_i(&b.c[k]);
+            t[q] += out[k].torque_i;
+        }
+        b.n = 0;
     }
 }
 
@@ -127,14 +200,15 @@ struct WallStage {
 
 impl Stage for WallStage {
     fn apply(&self, c: &mut Chunk<'_>) {
-        let (lo, hi) = (c.lo as u32, (c.lo + c.f.len()) as u32);
+        let Chunk { lo, x, v, omega, radius, mass, kind, mask, f, torque, extra } = c;
+        let (lo, hi) = (*lo as u32, (*lo + f.len()) as u32);
         let cands = &self.candidates[self.candidates.partition_point(|&i| i < lo)..];
-        let w = self.laws.width.max(1);
-        for &i in cands.iter().take_while(|&&i| i < hi) {
-            let (i, q) = (i as usize, (i - lo) as usize);
-            let s = Sphere { x: c.x[q], v: c.v[q], omega: c.omega[q], radius: c.radius[i], mass: c.mass[i], kind: c.kind[i], mask: c.mask[i] };
-            self.laws.touch(&self.frame, &s, &mut c.f[q], &mut c.torque[q], &mut c.extra[self.col][q * w..(q + 1) * w], None);
-        }
+        let qs = cands.iter().take_while(|&&i| i < hi).map(|&i| (i - lo) as usize);
+        let sphere = |q: usize| {
+            let i = lo as usize + q;
+            Sphere { x: x[q], v: v[q], omega: omega[q], radius: radius[i], mass: mass[i], kind: kind[i], mask: mask[i] }
+        };
+        self.laws.touch_chunk(&self.frame, qs, sphere, f, torque, &mut *extra[self.col], None, |_| {});
     }
 }
 
@@ -244,10 +318,7 @@ impl Fix for WallGran {
                 jobs.push((&cands[c * CHUNK..((c + 1) * CHUNK).min(cands.len())], win[0], fc, tc, hc));
             }
             let run = |(cs, lo, fc, tc, hc): (&[u32], usize, &mut [V3], &mut [V3], &mut [f64])| {
-                for &i in cs {
-                    let q = i as usize - lo;
-                    laws.touch(&fr, &sphere(i as usize), &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], None);
-                }
+                laws.touch_chunk(&fr, cs.iter().map(|&i| i as usize - lo), |q| sphere(lo + q), fc, tc, hc, None, |_| {});
             };
             if jobs.len() > 1 {
                 jobs.into_par_iter().for_each(run);
@@ -261,12 +332,8 @@ impl Fix for WallGran {
         // the bits do not depend on the thread count
         let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Vec<u32> {
             let mut near = vec![];
-            for q in 0..fc.len() {
-                let i = c * CHUNK + q;
-                if laws.touch(&fr, &sphere(i), &mut fc[q], &mut tc[q], &mut hc[q * w..(q + 1) * w], margin) {
-                    near.push(i as u32);
-                }
-            }
+            let lo = c * CHUNK;
+            laws.touch_chunk(&fr, 0..fc.len(), |q| sphere(lo + q), fc, tc, hc, margin, |q| near.push((lo + q) as u32));
             near
         };
         let near: Vec<Vec<u32>> = if f.len() >= 2 * CHUNK {
