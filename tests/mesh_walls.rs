@@ -304,3 +304,56 @@ fn moving_rotating_region_floor_matches_lmp() {
     // the sphere was carried along +x by the moving floor
     assert!(got.last().expect("rows")[2] > 0.0205);
 }
+
+/// The dump of 9,680 spheres of 2 mm thrown down onto the pyramid mesh
+/// (apex, edges and faces) at 1.5 m/s, 800 steps, with `neigh`.
+fn pyramid_shower(neigh: &str) -> String {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let dump = tmp.path().join("dump.shower");
+    let deck = format!(
+        "atom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
+         region reg block -0.06 0.06 -0.06 0.06 -0.02 0.1 units box\ncreate_box 1 reg\n{neigh}\n\
+         fix m1 all property/global youngsModulus peratomtype 5.e6\nfix m2 all property/global poissonsRatio peratomtype 0.45\n\
+         fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+         pair_style gran model hertz tangential history\npair_coeff * *\ntimestep 0.00001\n\
+         fix cad all mesh/surface file ${{DIR}}/pyramid.stl type 1\n\
+         fix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
+         lattice sc 0.0022\nregion start block -0.0484 0.0484 -0.0484 0.0484 0.0112 0.0222 units box\ncreate_atoms 1 region start\n\
+         set group all diameter 0.002 density 2500\nvelocity all set 0.1 0.05 -1.5 units box\n\
+         fix 1 all nve/sphere\nfix 2 all gravity 9.81 vector 0.0 0.0 -1.0\nthermo_modify lost ignore norm no\n\
+         dump d all custom 200 {} id x y z vx vy vz omegax omegay omegaz\n\
+         dump_modify d sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\"\nrun 800\n",
+        dump.display()
+    );
+    let (s, _) = run_deck(&deck, &[]);
+    assert!(s.sim.particles.len() > 2 * demx::engine::integrate::CHUNK, "{} spheres: one chunk", s.sim.particles.len());
+    std::fs::read_to_string(&dump).expect("dump")
+}
+
+/// A mesh at rest keeps, per particle, the triangles within reach plus the
+/// skin at the last pair-list build (`WallGranMesh::post_force`); that must
+/// change no bit against searching the mesh's bins every step (`check no`
+/// rebuilds every step, and the cache is then not used), on more than one
+/// chunk of particles.
+#[test]
+fn mesh_triangle_cache_changes_no_bit() {
+    let cached = pyramid_shower("neighbor 0.001 bin\nneigh_modify delay 0");
+    let searched = pyramid_shower("neighbor 0.001 bin\nneigh_modify delay 0 every 1 check no");
+    // many spheres overlap the pyramid in the last frame (their height
+    // above its surface, z = 10 mm (1 - max(|x|, |y|) / 50 mm), is below
+    // the radius)
+    let last = cached.rsplit("ITEM: ATOMS").next().unwrap();
+    let touching = last
+        .lines()
+        .skip(1)
+        .filter(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
+            v[3] - 0.001 < 0.01 * (1.0 - v[1].abs().max(v[2].abs()) / 0.05)
+        })
+        .count();
+    assert!(touching > 300, "only {touching} spheres touch the pyramid");
+    if cached != searched {
+        let line = cached.lines().zip(searched.lines()).position(|(a, b)| a != b).unwrap_or(0) + 1;
+        panic!("the triangle cache changed the dump from line {line}");
+    }
+}

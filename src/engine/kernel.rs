@@ -460,23 +460,21 @@ struct Block<'a> {
     pe: usize,
 }
 
-thread_local! {
-    /// Tests set it to run the per-contact pass where the batched one would
-    /// run, to check that both give the same bits.
-    static SCALAR_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
+super::switch::switch!(
+    /// Tests switch it on to run the laws contact by contact where they
+    /// would run on lanes (pairs and walls), to check that both give the
+    /// same bits.
+    SCALAR_ONLY
+);
 
-/// Run `f` with the batched pair pass switched off on this thread (tests).
+/// Run `f` with the laws on lanes switched off on this thread (tests).
 pub fn with_scalar_pass<T>(f: impl FnOnce() -> T) -> T {
-    SCALAR_ONLY.with(|s| s.set(true));
-    let r = f();
-    SCALAR_ONLY.with(|s| s.set(false));
-    r
+    SCALAR_ONLY.on_during(f)
 }
 
 impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C, R> {
     fn scalar_only(&self) -> bool {
-        SCALAR_ONLY.with(|s| s.get())
+        SCALAR_ONLY.is_on()
     }
 
     /// One block of the batched pass. The same contributions, added in the

@@ -63,6 +63,9 @@ pub struct SurfaceMesh {
     /// The mover has made a step: node velocities are set. Before that
     /// (the setup right after `fix move/mesh`) LIGGGHTS sees a resting mesh.
     pub moving: bool,
+    /// Counts the changes of the triangles ([`SurfaceMesh::bake`]): a cache
+    /// of triangles near particles holds for one epoch.
+    pub epoch: u64,
 }
 
 fn bits(v: V3) -> [u64; 3] {
@@ -219,7 +222,7 @@ impl SurfaceMesh {
             }).sum::<f64>() / n as f64
         };
         let bins = TriangleBins::new(&mesh, cell);
-        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None, moving: false }
+        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None, moving: false, epoch: 0 }
     }
 
     /// Whether all triangles lie in one plane within the curvature
@@ -310,6 +313,7 @@ impl SurfaceMesh {
         self.bins = TriangleBins::new(&Mesh::new(self.tris.clone()), cell);
         self.motion = None;
         self.moving = false;
+        self.epoch += 1;
     }
 
     fn bins_cell(&self) -> f64 {
@@ -318,6 +322,13 @@ impl SurfaceMesh {
             let (a, b) = t.bounds();
             (b - a).max()
         }).sum::<f64>() / n
+    }
+
+    /// The triangles (increasing) closer than `reach` to point `p`
+    /// (reference frame): every triangle that a sphere centred within
+    /// `reach - r` of `p` can touch with radius `r`.
+    pub fn near(&self, p: V3, reach: f64) -> impl Iterator<Item = usize> + '_ {
+        self.bins.candidates(p, reach).into_iter().filter(move |&t| (p - closest_point_on_triangle(p, &self.tris[t]).0).norm_squared() < reach * reach)
     }
 
     /// Contact of a sphere (reference frame) with triangle `t` under the
@@ -394,11 +405,24 @@ pub struct MeshHit {
 /// reference frame) with the mesh, maintaining its slots with the
 /// LIGGGHTS duplicate rule; `apply(hit, history)` is called for every
 /// contact that produces a force, in increasing triangle order.
-pub fn resolve_particle(mesh: &SurfaceMesh, p: V3, radius: f64, slots: Slots, mut apply: impl FnMut(&MeshHit, &mut [f64])) -> Result<()> {
+pub fn resolve_particle(mesh: &SurfaceMesh, p: V3, radius: f64, slots: Slots, apply: impl FnMut(&MeshHit, &mut [f64])) -> Result<()> {
+    resolve_among(mesh, mesh.bins.candidates(p, radius), p, radius, slots, apply)
+}
+
+/// [`resolve_particle`] over the triangles `cands` (increasing), which
+/// must include every triangle within `radius` of `p` (the others find no
+/// contact and change nothing).
+pub fn resolve_among(
+    mesh: &SurfaceMesh,
+    cands: impl IntoIterator<Item = usize>,
+    p: V3,
+    radius: f64,
+    slots: Slots,
+    mut apply: impl FnMut(&MeshHit, &mut [f64]),
+) -> Result<()> {
     let w = 1 + slots.width;
     let data = slots.data;
     let mut touched = [false; MESH_SLOTS];
-    let cands = mesh.bins.candidates(p, radius);
     for t in cands {
         let Some((delta, normal, point)) = mesh.triangle_contact(t, p, radius) else { continue };
         let idv = (t + 1) as f64;

@@ -16,5 +16,6 @@ pub mod wind;
 pub mod guard;
 pub mod awake;
 pub mod hugepages;
+pub mod switch;
 
 pub use sim::{Dialect, Sim};

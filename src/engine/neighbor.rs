@@ -173,18 +173,15 @@ const PRUNE_MIN: f64 = 1.0 / 64.0;
 /// A buffer this fraction of the skin or more: the list stays full.
 const PRUNE_MAX: f64 = 0.5;
 
-thread_local! {
-    /// Tests set it to keep the list full, to check that pruning changes
-    /// no bit.
-    static NO_PRUNE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
+super::switch::switch!(
+    /// Tests switch it on to keep the list full, to check that pruning
+    /// changes no bit.
+    NO_PRUNE
+);
 
 /// Run `f` with pair-list pruning switched off on this thread (tests).
 pub fn without_pruning<T>(f: impl FnOnce() -> T) -> T {
-    NO_PRUNE.with(|u| u.set(true));
-    let r = f();
-    NO_PRUNE.with(|u| u.set(false));
-    r
+    NO_PRUNE.on_during(f)
 }
 
 /// Particles per block of the force pass. Fixed, never derived from the
@@ -446,7 +443,8 @@ impl PairList {
     /// Whether the list is pruned (the step's check measures
     /// [`Travel::pruned`] then, whatever `neigh_modify` asks).
     pub fn pruned(&self) -> bool {
-        !self.x_pruned.is_empty()
+        debug_assert_eq!(self.outer.is_some(), !self.x_pruned.is_empty());
+        self.outer.is_some()
     }
 
     /// The answer of a [`Due::Check`] at `step` once `moved` is known over all
@@ -561,11 +559,15 @@ impl PairList {
     /// history.
     pub fn prune<F: Fn(usize, usize) -> f64>(&mut self, p: &Particles, s: &NeighSettings, buffer: f64, step: i64, extra_range: &F) {
         let n = p.len();
-        // positions in single precision and their largest rounding error,
-        // which the check's limit leaves room for
-        let mut eps2: f64 = 0.0;
-        let x_pruned: Vec<[f32; 3]> =
-            p.x.iter()
+        let mut x_pruned = vec![];
+        let mut half = 0.0;
+        if buffer < PRUNE_MAX * s.skin && buffer > 0.0 && n > 0 && !NO_PRUNE.is_on() {
+            // positions in single precision and their largest rounding
+            // error, which the check's limit leaves room for
+            let mut eps2: f64 = 0.0;
+            x_pruned = p
+                .x
+                .iter()
                 .map(|x| {
                     let q = [x.x as f32, x.y as f32, x.z as f32];
                     let d = [x.x - q[0] as f64, x.y - q[1] as f64, x.z - q[2] as f64];
@@ -573,10 +575,10 @@ impl PairList {
                     q
                 })
                 .collect();
-        // a relative margin for the rounding of the distances themselves
-        let half = 0.5 * buffer * (1.0 - 1e-9) - eps2.sqrt();
-        let full = buffer >= PRUNE_MAX * s.skin || !(half > 0.0) || n == 0 || NO_PRUNE.with(|u| u.get());
-        if full {
+            // a relative margin for the rounding of the distances themselves
+            half = 0.5 * buffer * (1.0 - 1e-9) - eps2.sqrt();
+        }
+        if !(half > 0.0) {
             if self.outer.is_some() {
                 self.refilter(|_, _, _| true);
             } else {

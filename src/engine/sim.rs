@@ -17,18 +17,16 @@ use std::time::Instant;
 /// two threads get equal shares of a 30,000-particle bed.
 const TAIL_CHUNK: usize = 1024;
 
-thread_local! {
-    /// Tests set it to call every hook of the step's head and tail on its
-    /// own, as one pass per hook, to check that fusing gives the same bits.
-    static UNFUSED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
+super::switch::switch!(
+    /// Tests switch it on to call every hook of the step's head and tail on
+    /// its own, as one pass per hook, to check that fusing gives the same
+    /// bits.
+    UNFUSED
+);
 
 /// Run `f` with the step's head and tail unfused on this thread (tests).
 pub fn with_unfused_tail<T>(f: impl FnOnce() -> T) -> T {
-    UNFUSED.with(|u| u.set(true));
-    let r = f();
-    UNFUSED.with(|u| u.set(false));
-    r
+    UNFUSED.on_during(f)
 }
 
 /// Which engine's conventions a deck follows.
@@ -356,7 +354,9 @@ impl Sim {
     /// Returns the same for the next step when this step's tail runs its
     /// head ([`Sim::fuse_next`]).
     fn one_step(&mut self, vars: &Variables, carried: Option<Travel>) -> Result<Option<Travel>> {
-        let t = Instant::now();
+        // one clock reading between sections (each costs ~50 ns here, a
+        // tenth of a step of a few hundred particles)
+        let t0 = Instant::now();
         let (moved, due) = match carried {
             Some(moved) => (moved, self.due()),
             None => {
@@ -366,8 +366,7 @@ impl Sim {
         };
         let step = self.step;
         let wanted = self.fixes.iter().any(|f| f.next_reneighbor() == Some(step));
-        let tm = t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        let t1 = Instant::now();
         let build = self.force_rebuild
             || wanted
             || match due {
@@ -382,10 +381,9 @@ impl Sim {
         } else if self.pairs.prune_due(&moved) {
             self.prune(self.pairs.next_buffer(&self.neigh, step));
         }
-        let tn = t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        let t2 = Instant::now();
         self.pair_pass(self.dt);
-        let tp = t.elapsed().as_secs_f64();
+        let t3 = Instant::now();
         // the step's tail: the cross-block shares of the pair forces, then
         // every fix's post_force, then every fix's final_integrate, in
         // LAMMPS order. Hooks that act particle by particle ([`Fix::local`])
@@ -394,7 +392,6 @@ impl Sim {
         // meets the same operations in the same order, so the bits are those
         // of one pass per hook. A hook that needs the whole simulation ends
         // the fused run before it and is called as it is.
-        let t = Instant::now();
         let mut gather = true;
         let mut stages = vec![];
         self.hooks(&[Hook::PostForce, Hook::FinalIntegrate], vars, &mut gather, &mut stages)?;
@@ -413,15 +410,17 @@ impl Sim {
             }
             None
         };
-        let tm2 = t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        let t4 = Instant::now();
         if next.is_none() {
             self.output(vars, false)?;
         }
-        self.timing[0] += tp;
-        self.timing[1] += tn;
-        self.timing[2] += tm + tm2;
-        self.timing[3] += t.elapsed().as_secs_f64();
+        let secs = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64();
+        self.timing[0] += secs(t2, t3);
+        self.timing[1] += secs(t1, t2);
+        self.timing[2] += secs(t0, t1) + secs(t3, t4);
+        if next.is_none() {
+            self.timing[3] += t4.elapsed().as_secs_f64();
+        }
         Ok(next)
     }
 
@@ -448,7 +447,7 @@ impl Sim {
         let step = self.step;
         let every = self.thermo.every;
         step < self.run_end
-            && !UNFUSED.with(|u| u.get())
+            && !UNFUSED.is_on()
             && !(every > 0 && step % every == 0)
             && !self.guard.due(step)
             && !self.dumps.iter().any(|d| d.due(step, false))
@@ -464,7 +463,7 @@ impl Sim {
     fn head(&mut self, vars: &Variables, check: bool) -> Result<Travel> {
         let mut stages = vec![];
         self.hooks(&[Hook::InitialIntegrate], vars, &mut false, &mut stages)?;
-        if UNFUSED.with(|u| u.get()) {
+        if UNFUSED.is_on() {
             // the check on its own, as tests compare
             return Ok(self.pairs.travel_all(&self.particles.x, check));
         }
@@ -475,7 +474,7 @@ impl Sim {
     /// `stages`, a whole hook first runs them (and the cross pass, while
     /// `gather`) and is then called. Leaves the stages still pending.
     fn hooks(&mut self, hooks: &[Hook], vars: &Variables, gather: &mut bool, stages: &mut Vec<Box<dyn Stage>>) -> Result<()> {
-        let fuse = !UNFUSED.with(|u| u.get());
+        let fuse = !UNFUSED.is_on();
         for &hook in hooks {
             for k in 0..self.fixes.len() {
                 let mut fix = std::mem::replace(&mut self.fixes[k], Box::new(Hole));

@@ -14,7 +14,8 @@ use super::model::{self, NormalSpec, PairSpec, TangentialSpec};
 use super::Session;
 use crate::engine::fix::{Fix, Hook, Local};
 use crate::engine::kernel::{ContactKernel, ParamTable};
-use crate::engine::mesh_surface::{resolve_particle, SharedMesh, Slots, SurfaceMesh, DEFAULT_CURVATURE_COS, MESH_SLOTS};
+use crate::engine::integrate::CHUNK;
+use crate::engine::mesh_surface::{resolve_among, resolve_particle, MeshHit, SharedMesh, Slots, SurfaceMesh, DEFAULT_CURVATURE_COS, MESH_SLOTS};
 use crate::engine::output::Dump;
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
@@ -22,6 +23,7 @@ use crate::geom::mesh::parse_mesh_transforms;
 use crate::geom::{MeshMotion, Region, Triangle};
 use crate::physics::{Contact, V3};
 use crate::script::{Command, Variables, Word};
+use rayon::prelude::*;
 use std::sync::{Arc, RwLock};
 
 /// Parse a mesh- or region-wall fix.
@@ -333,6 +335,12 @@ fn move_mesh(s: &mut Session, cmd: &Command, id: &str, a: &mut Args) -> Result<(
 struct WallMesh {
     mesh: SharedMesh,
     hist_name: String,
+    /// Per particle, the triangles within reach + skin of it at pair-list
+    /// build `near_at.0` of mesh epoch `near_at.1` (CSR: particle i's are
+    /// `near[start[i]..start[i + 1]]`, increasing); see `post_force`.
+    near: Vec<u32>,
+    start: Vec<u32>,
+    near_at: Option<(u64, u64)>,
 }
 
 /// LIGGGHTS `fix wall/gran ... mesh n_meshes N meshes ...`.
@@ -370,53 +378,118 @@ impl Fix for WallGranMesh {
         self.in_setup = true;
         Ok(())
     }
+    /// Between pair-list builds no particle moves more than half the skin
+    /// when every step checks for a build (delay 0, every 1, check yes), as
+    /// for primitive walls: then a mesh at rest needs, per particle, only
+    /// the triangles within reach + skin of it at the build, found once per
+    /// build (LIGGGHTS keeps such a list too, `fix neighlist/mesh`). A
+    /// moving mesh, or a run checking less often, searches the mesh's bins
+    /// every step. Either way the triangles are tried in increasing index,
+    /// and those left out touch nothing, so the bits are the same.
+    /// Particles run in fixed chunks, in parallel from two chunks up: each
+    /// touches only its own force, torque and slots.
     fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
         let len = self.slot_len();
         let time = sim.time;
         // dt = 0 leaves the history where it is (setup force evaluation)
         let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
-        for wm in &self.meshes {
+        let ns = &sim.neigh;
+        let steady = sim.pairs.x_built.len() == sim.particles.len() && ns.check && ns.delay == 0 && ns.every <= 1;
+        let (builds, skin) = (sim.pairs.builds, ns.skin);
+        let (group, width, kernel, table) = (self.group, self.width, &*self.kernel, &self.table);
+        for wm in &mut self.meshes {
             let col = sim.particles.add_extra(&wm.hist_name, vec![0.0; len]);
             let mesh = wm.mesh.read().map_err(|_| lock_err())?;
-            let p = &mut sim.particles;
-            for i in 0..p.len() {
-                if p.mask[i] & self.group == 0 {
-                    continue;
+            let mesh = &*mesh;
+            let bounded = steady && mesh.motion.is_none();
+            let crate::engine::particles::Particles { x, v, omega, f, torque, radius, mass, kind, mask, extra, .. } = &mut sim.particles;
+            let (x, v, omega, radius, mass, kind, mask) = (&*x, &*v, &*omega, &*radius, &*mass, &*kind, &*mask);
+            let n = f.len();
+            if !bounded {
+                wm.near_at = None;
+            } else if wm.near_at != Some((builds, mesh.epoch)) {
+                let find = |lo: usize, hi: usize| -> (Vec<u32>, Vec<u32>) {
+                    let (mut tris, mut counts) = (vec![], Vec::with_capacity(hi - lo));
+                    for i in lo..hi {
+                        let before = tris.len();
+                        if mask[i] & group != 0 {
+                            tris.extend(mesh.near(x[i], radius[i] + skin).map(|t| t as u32));
+                        }
+                        counts.push((tris.len() - before) as u32);
+                    }
+                    (tris, counts)
+                };
+                let parts: Vec<(Vec<u32>, Vec<u32>)> = if n >= 2 * CHUNK {
+                    (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| find(c * CHUNK, ((c + 1) * CHUNK).min(n))).collect()
+                } else {
+                    vec![find(0, n)]
+                };
+                wm.near.clear();
+                wm.start.clear();
+                wm.start.push(0);
+                for (tris, counts) in parts {
+                    wm.near.extend(tris);
+                    for c in counts {
+                        wm.start.push(wm.start.last().copied().unwrap_or(0) + c);
+                    }
                 }
-                let (xi, ri, vi, wi, mi, kind) = (p.x[i], p.radius[i], p.v[i], p.omega[i], p.mass[i], p.kind[i]);
-                let pref = mesh.to_reference(xi, time);
-                let data = &mut p.extra[col].data[i * len..(i + 1) * len];
-                let pp = self.table.get(kind, mesh.wall_type);
-                let (mut f, mut tq) = (V3::zeros(), V3::zeros());
-                let kernel = &self.kernel;
-                resolve_particle(&mesh, pref, ri, Slots { data, width: self.width }, |hit, hist| {
-                    let n = mesh.dir_to_world(hit.normal, time);
-                    let point = mesh.to_world(hit.point, time);
-                    let vwall = mesh.wall_velocity(point, hit.tri, time);
-                    let vr = vi - vwall;
-                    let c = Contact {
-                        n,
-                        r: ri - hit.delta,
-                        delta: hit.delta,
-                        ri,
-                        rj: f64::INFINITY,
-                        r_eff: ri,
-                        mi,
-                        mj: f64::INFINITY,
-                        m_eff: mi,
-                        vr,
-                        vn: vr.dot(&n),
-                        wi,
-                        wj: V3::zeros(),
-                        dt,
-                    };
-                    let out = kernel.contact(&c, pp, hist);
-                    f += out.force_i(&c);
-                    tq += out.torque_i;
-                })?;
-                p.f[i] += f;
-                p.torque[i] += tq;
+                wm.near_at = Some((builds, mesh.epoch));
             }
+            let (near, start) = (&wm.near[..], &wm.start[..]);
+            let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Result<()> {
+                for q in 0..fc.len() {
+                    let i = c * CHUNK + q;
+                    if mask[i] & group == 0 {
+                        continue;
+                    }
+                    let (xi, ri, vi, wi, mi) = (x[i], radius[i], v[i], omega[i], mass[i]);
+                    let pref = mesh.to_reference(xi, time);
+                    let pp = table.get(kind[i], mesh.wall_type);
+                    let (mut fs, mut ts) = (V3::zeros(), V3::zeros());
+                    let slots = Slots { data: &mut hc[q * len..(q + 1) * len], width };
+                    let apply = |hit: &MeshHit, hist: &mut [f64]| {
+                        let nrm = mesh.dir_to_world(hit.normal, time);
+                        let point = mesh.to_world(hit.point, time);
+                        let vwall = mesh.wall_velocity(point, hit.tri, time);
+                        let vr = vi - vwall;
+                        let c = Contact {
+                            n: nrm,
+                            r: ri - hit.delta,
+                            delta: hit.delta,
+                            ri,
+                            rj: f64::INFINITY,
+                            r_eff: ri,
+                            mi,
+                            mj: f64::INFINITY,
+                            m_eff: mi,
+                            vr,
+                            vn: vr.dot(&nrm),
+                            wi,
+                            wj: V3::zeros(),
+                            dt,
+                        };
+                        let out = kernel.contact(&c, pp, hist);
+                        fs += out.force_i(&c);
+                        ts += out.torque_i;
+                    };
+                    if bounded {
+                        let cands = near[start[i] as usize..start[i + 1] as usize].iter().map(|&t| t as usize);
+                        resolve_among(mesh, cands, pref, ri, slots, apply)?;
+                    } else {
+                        resolve_particle(mesh, pref, ri, slots, apply)?;
+                    }
+                    fc[q] += fs;
+                    tc[q] += ts;
+                }
+                Ok(())
+            };
+            let data = &mut extra[col].data[..n * len];
+            let done: Vec<Result<()>> = if n >= 2 * CHUNK {
+                f.par_chunks_mut(CHUNK).zip(torque.par_chunks_mut(CHUNK)).zip(data.par_chunks_mut(CHUNK * len)).enumerate().map(body).collect()
+            } else {
+                f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * len)).enumerate().map(body).collect()
+            };
+            done.into_iter().collect::<Result<Vec<()>>>()?;
         }
         Ok(())
     }
@@ -468,7 +541,7 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
     for _ in 0..n {
         let w = a.word("mesh id")?;
         let m = need_mesh(s, w)?;
-        meshes.push(WallMesh { mesh: m, hist_name: format!("mesh_history:{id}:{}", w.text) });
+        meshes.push(WallMesh { mesh: m, hist_name: format!("mesh_history:{id}:{}", w.text), near: vec![], start: vec![], near_at: None });
         names.push(w.text.clone());
     }
     while a.more() {
