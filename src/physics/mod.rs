@@ -61,6 +61,16 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// A contact of sphere i (radius `ri`, mass `mi`, spin `wi`) with a wall
+    /// of infinite radius and mass: normal `n` from the wall into the
+    /// sphere, overlap `delta`, centre-to-contact-point distance `r`,
+    /// effective radius `r_eff` (`ri`, or with a curved wall's radius), and
+    /// `vr` the sphere's velocity less the wall's at the contact point.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub fn with_wall(n: V3, r: f64, delta: f64, ri: f64, r_eff: f64, mi: f64, vr: V3, wi: V3, dt: f64) -> Contact {
+        Contact { n, r, delta, ri, rj: f64::INFINITY, r_eff, mi, mj: f64::INFINITY, m_eff: mi, vr, vn: vr.dot(&n), wi, wj: V3::zeros(), dt }
+    }
     /// Whether the surfaces touch.
     #[inline(always)]
     pub fn touching(&self) -> bool {

@@ -335,7 +335,7 @@ fn move_mesh(s: &mut Session, cmd: &Command, id: &str, a: &mut Args) -> Result<(
 struct WallMesh {
     mesh: SharedMesh,
     hist_name: String,
-    /// Per particle, the triangles within reach + skin of it at pair-list
+    /// Per particle, the triangles within reach + 5/8 skin of it at pair-list
     /// build `near_at.0` of mesh epoch `near_at.1` (CSR: particle i's are
     /// `near[start[i]..start[i + 1]]`, increasing); see `post_force`.
     near: Vec<u32>,
@@ -381,7 +381,8 @@ impl Fix for WallGranMesh {
     /// Between pair-list builds no particle moves more than half the skin
     /// when every step checks for a build (delay 0, every 1, check yes), as
     /// for primitive walls: then a mesh at rest needs, per particle, only
-    /// the triangles within reach + skin of it at the build, found once per
+    /// the triangles that can come within reach of it before the next
+    /// build (those within reach + 5/8 of the skin at the build), found once per
     /// build (LIGGGHTS keeps such a list too, `fix neighlist/mesh`). A
     /// moving mesh, or a run checking less often, searches the mesh's bins
     /// every step. Either way the triangles are tried in increasing index,
@@ -408,12 +409,18 @@ impl Fix for WallGranMesh {
             if !bounded {
                 wm.near_at = None;
             } else if wm.near_at != Some((builds, mesh.epoch)) {
+                // a triangle at distance D from a particle at the build stays
+                // beyond D - skin/2 until the next build, and touches only
+                // below the radius: D < r + skin/2 keeps every one that can
+                // touch; a quarter of that more, and a relative 1e-9 of the
+                // radius, cover the rounding of the distances
+                let reach_skin = 0.625 * skin;
                 let find = |lo: usize, hi: usize| -> (Vec<u32>, Vec<u32>) {
                     let (mut tris, mut counts) = (vec![], Vec::with_capacity(hi - lo));
                     for i in lo..hi {
                         let before = tris.len();
                         if mask[i] & group != 0 {
-                            tris.extend(mesh.near(x[i], radius[i] + skin).map(|t| t as u32));
+                            tris.extend(mesh.near(x[i], radius[i] * (1.0 + 1e-9) + reach_skin).map(|t| t as u32));
                         }
                         counts.push((tris.len() - before) as u32);
                     }
@@ -452,22 +459,7 @@ impl Fix for WallGranMesh {
                         let point = mesh.to_world(hit.point, time);
                         let vwall = mesh.wall_velocity(point, hit.tri, time);
                         let vr = vi - vwall;
-                        let c = Contact {
-                            n: nrm,
-                            r: ri - hit.delta,
-                            delta: hit.delta,
-                            ri,
-                            rj: f64::INFINITY,
-                            r_eff: ri,
-                            mi,
-                            mj: f64::INFINITY,
-                            m_eff: mi,
-                            vr,
-                            vn: vr.dot(&nrm),
-                            wi,
-                            wj: V3::zeros(),
-                            dt,
-                        };
+                        let c = Contact::with_wall(nrm, ri - hit.delta, hit.delta, ri, ri, mi, vr, wi, dt);
                         let out = kernel.contact(&c, pp, hist);
                         fs += out.force_i(&c);
                         ts += out.torque_i;
@@ -688,22 +680,7 @@ impl Fix for WallGranRegion {
                 }
                 let mi = p.mass[i];
                 let vr = p.v[i] - vwall;
-                let c = Contact {
-                    n,
-                    r: sc.distance,
-                    delta,
-                    ri,
-                    rj: f64::INFINITY,
-                    r_eff: ri,
-                    mi,
-                    mj: f64::INFINITY,
-                    m_eff: mi,
-                    vr,
-                    vn: vr.dot(&n),
-                    wi: p.omega[i],
-                    wj: V3::zeros(),
-                    dt,
-                };
+                let c = Contact::with_wall(n, sc.distance, delta, ri, ri, mi, vr, p.omega[i], dt);
                 let out = self.kernel.contact(&c, pp, &mut data[k * w + 4..(k + 1) * w]);
                 p.f[i] += out.force_i(&c);
                 p.torque[i] += out.torque_i;

@@ -108,23 +108,7 @@ impl WallLaws {
         };
         let mi = s.mass;
         let vr = s.v - fr.vwall;
-        let c = Contact {
-            n,
-            r: ri - delta,
-            delta,
-            ri,
-            rj: f64::INFINITY,
-            r_eff,
-            mi,
-            mj: f64::INFINITY,
-            m_eff: mi,
-            vr,
-            vn: vr.dot(&n),
-            wi: s.omega,
-            wj: V3::zeros(),
-            dt: fr.dt,
-        };
-        Meet::Touch(c, pp)
+        Meet::Touch(Contact::with_wall(n, ri - delta, delta, ri, r_eff, mi, vr, s.omega, fr.dt), pp)
     }
 
     /// The wall's contacts with the particles at chunk positions `qs`
