@@ -15,6 +15,8 @@ Decks (bench/ and ../shared/bench/chute, as the performance issue lists them):
   d   the stock heap template at d = 1 mm and full glass stiffness (Y = 63 GPa),
       the first chunks of the pour
   e   scaling: the bed tiled from 7,500 to 1,080,000 particles (demx alone)
+  f   Debian's meshGran tutorial (LIGGGHTS): spheres streamed into a hopper of
+      triangle-mesh walls, its second run cut to 20,000 steps in all
 The bed is made by bench/in.bed_prepare.liggghts (7,500 spheres settled in a
 20 x 20 mm periodic box) and tiled in x and y.
 """
@@ -24,7 +26,23 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEMX = os.path.join(ROOT, "target", "release", "demx")
 WORK = os.path.join(ROOT, "target", "bench")
 CHUTE = os.path.join(os.path.dirname(ROOT), "shared", "bench", "chute")
+MESHGRAN = "/usr/share/doc/liggghts/examples/LIGGGHTS/Tutorials_public/meshGran"
 PROFILE_BEGIN, PROFILE_END = "<!-- bench:begin (scripts/bench.py) -->", "<!-- bench:end -->"
+
+
+def prepare_meshgran():
+    """The meshGran tutorial in target/bench/meshGran (it reads meshes/ and
+    writes post/ where it runs), its last run ending at step ${nsteps}."""
+    d = os.path.join(WORK, "meshGran")
+    os.makedirs(os.path.join(d, "post"), exist_ok=True)
+    shutil.copytree(os.path.join(MESHGRAN, "meshes"), os.path.join(d, "meshes"), dirs_exist_ok=True)
+    text = open(os.path.join(MESHGRAN, "in.meshGran")).read()
+    deck = re.sub(r"^run\s+40000 upto", "run ${nsteps} upto", text, flags=re.M)
+    if deck == text:
+        raise RuntimeError("in.meshGran: its `run 40000 upto` line was not found")
+    with open(os.path.join(d, "in.meshGran"), "w") as f:
+        f.write(deck)
+    return d
 
 
 def run(cmd, cwd, env=None):
@@ -137,14 +155,14 @@ def engine_cmd(engine, deck, ranks, var):
     return cmd
 
 
-def case(name, deck, engine, var, reps, threads=1, ranks=1, engine_deck=None):
+def case(name, deck, engine, var, reps, threads=1, ranks=1, engine_deck=None, cwd=WORK):
     """Interleaved runs of demx and the engine; medians."""
     d_ps, e_ps, d_rss, e_rss, d_sec, e_sec = [], [], [], [], [], []
     for _ in range(reps):
-        out, rss = run(demx_cmd(deck, threads, var), WORK)
+        out, rss = run(demx_cmd(deck, threads, var), cwd)
         d_ps.append(rate(out)[0]); d_rss.append(rss); d_sec.append(sections(out, "demx"))
         if engine:
-            out, rss = run(engine_cmd(engine, engine_deck or deck, ranks, var), WORK)
+            out, rss = run(engine_cmd(engine, engine_deck or deck, ranks, var), cwd)
             e_ps.append(rate(out)[0]); e_rss.append(rss); e_sec.append(sections(out, engine))
     md = statistics.median(d_ps)
     me = statistics.median(e_ps) if e_ps else None
@@ -175,7 +193,7 @@ def ceiling(deck, var, reps):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--reps", type=int, default=5)
-    ap.add_argument("--only", default="a,a2,b1,b2,c,d,e")
+    ap.add_argument("--only", default="a,a2,b1,b2,c,d,e,f")
     ap.add_argument("--quick", action="store_true", help="small beds and few steps (checks the harness)")
     ap.add_argument("--steps", type=int, default=1000, help="steps per bed run (the chute runs twice as many)")
     ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
@@ -209,6 +227,10 @@ def main():
         rows.append(case("(d) stock heap, d = 1 mm, Y = 63 GPa, first chunks of the pour",
                          os.path.join(ROOT, "templates", "heap", "in.heap"), "liggghts",
                          dict(model="stock", Y="6.3e10", N=100 if a.quick else 300, relax=1), 1 if a.quick else min(3, a.reps)))
+    if "f" in only:
+        mg = prepare_meshgran()
+        rows.append(case("(f) meshGran tutorial, mesh walls + insert/stream, 20,000 steps", os.path.join(mg, "in.meshGran"), "liggghts",
+                         dict(nsteps=11000 if a.quick else 20000), 1 if a.quick else min(3, a.reps), cwd=mg))
     scaling = []
     if "e" in only:
         for k in ([1, 2] if a.quick else [1, 2, 4, 8, 12]):
