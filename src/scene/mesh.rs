@@ -336,11 +336,12 @@ struct WallMesh {
     mesh: SharedMesh,
     hist_name: String,
     /// Per particle, the triangles within reach + 5/8 skin of it at pair-list
-    /// build `near_at.0` of mesh epoch `near_at.1` (CSR: particle i's are
-    /// `near[start[i]..start[i + 1]]`, increasing); see `post_force`.
+    /// build `near_at.0` of mesh epoch `near_at.1` for `near_at.2` particles
+    /// (CSR: particle i's are `near[start[i]..start[i + 1]]`, increasing);
+    /// see `post_force`.
     near: Vec<u32>,
     start: Vec<u32>,
-    near_at: Option<(u64, u64)>,
+    near_at: Option<(u64, u64, usize)>,
 }
 
 /// LIGGGHTS `fix wall/gran ... mesh n_meshes N meshes ...`.
@@ -408,7 +409,7 @@ impl Fix for WallGranMesh {
             let n = f.len();
             if !bounded {
                 wm.near_at = None;
-            } else if wm.near_at != Some((builds, mesh.epoch)) {
+            } else if wm.near_at != Some((builds, mesh.epoch, n)) {
                 // a triangle at distance D from a particle at the build stays
                 // beyond D - skin/2 until the next build, and touches only
                 // below the radius: D < r + skin/2 keeps every one that can
@@ -440,7 +441,7 @@ impl Fix for WallGranMesh {
                         wm.start.push(wm.start.last().copied().unwrap_or(0) + c);
                     }
                 }
-                wm.near_at = Some((builds, mesh.epoch));
+                wm.near_at = Some((builds, mesh.epoch, n));
             }
             let (near, start) = (&wm.near[..], &wm.start[..]);
             let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Result<()> {
