@@ -440,6 +440,11 @@ impl PairList {
         self.outer.is_some() && t.pruned > self.prune_lim
     }
 
+    /// Pairs of the last build: the full list's, while pruned.
+    pub fn listed(&self) -> usize {
+        self.outer.as_ref().map_or(self.a.len(), |o| o.a.len())
+    }
+
     /// Whether the list is pruned (the step's check measures
     /// [`Travel::pruned`] then, whatever `neigh_modify` asks).
     pub fn pruned(&self) -> bool {
@@ -473,7 +478,8 @@ impl PairList {
         let n = p.len();
         // a pruned list holds every pair with history: the carry reads it
         // as it reads a full one
-        let listed = self.outer.take().map_or(self.a.len(), |o| o.a.len());
+        let listed = self.listed();
+        self.outer = None;
         self.x_pruned.clear();
         let lens = dom.lengths();
         // the 27 images a cell stencil reaches, indexed by the cell shift

@@ -106,6 +106,8 @@ pub struct Sim {
     pub last_rate: f64,
     /// Time spent per section of the last run: pair, neigh, modify, output.
     pub timing: [f64; 4],
+    /// Pairs the force passes of the current run walked, summed over steps.
+    pub walked: u64,
     /// The state came from a restart file: the next run starts from the
     /// saved pair list and forces instead of recomputing them, so it continues
     /// bitwise as the uninterrupted run would have.
@@ -150,6 +152,7 @@ impl Default for Sim {
             boltz: 1.380649e-23,
             last_rate: 0.0,
             timing: [0.0; 4],
+            walked: 0,
             resume: false,
             sort_every: 1000,
             sort_bin: 0.0,
@@ -323,6 +326,7 @@ impl Sim {
         self.run_end = self.step + n;
         self.clock = Instant::now();
         self.timing = [0.0; 4];
+        self.walked = 0;
         if pre || self.pairs.x_built.len() != self.particles.len() {
             self.setup(vars)?;
         }
@@ -383,6 +387,7 @@ impl Sim {
         }
         let t2 = Instant::now();
         self.pair_pass(self.dt);
+        self.walked += self.pairs.a.len() as u64;
         let t3 = Instant::now();
         // the step's tail: the cross-block shares of the pair forces, then
         // every fix's post_force, then every fix's final_integrate, in
@@ -608,6 +613,14 @@ impl Sim {
         s.push_str(&format!("Neighbor list builds = {}\nDangerous builds = {}\n", self.pairs.builds, self.pairs.dangerous));
         if self.pairs.prunes > 0 {
             s.push_str(&format!("Pair list prunes = {} (last buffer {:.3e})\n", self.pairs.prunes, self.pairs.buffer));
+        }
+        if n > 0 && np > 0 {
+            let per = |m: f64| m / np as f64;
+            s.push_str(&format!(
+                "Pairs per particle = {:.3} walked per step, {:.3} within the skin at the end\n",
+                per(self.walked as f64 / n as f64),
+                per(self.pairs.listed() as f64)
+            ));
         }
         s
     }
