@@ -113,6 +113,11 @@ pub struct PairList {
     pub pruned_at: i64,
     /// Number of prunes so far.
     pub prunes: u64,
+    /// Fraction of the full list the last prune kept (0 before any).
+    pub kept: f64,
+    /// Builds to go before a prune is tried again, after one was judged
+    /// not to pay ([`PairList::prune_pays`]).
+    pub retry_in: u32,
     /// What the last check measured (see [`Travel`]).
     pub travel: Travel,
 }
@@ -172,6 +177,19 @@ const PRUNE_STEPS: f64 = 16.0;
 const PRUNE_MIN: f64 = 1.0 / 64.0;
 /// A buffer this fraction of the skin or more: the list stays full.
 const PRUNE_MAX: f64 = 0.5;
+/// What a prune costs, in walks of an apart pair by the force pass, per
+/// pair of the full list: the pick, the copy and the block index. Measured
+/// on the LAMMPS chute (scripts/bench.py case c, 1000 steps): 87 prunes
+/// took 0.20 s of Neigh for 113,000 pairs each (~20 ns a pair), and the
+/// force pass walked an apart pair in ~5.4 ns.
+const PRUNE_COST: f64 = 4.0;
+/// Builds without a prune after one that did not pay, before the next try.
+const PRUNE_RETRY: u32 = 4;
+
+/// Whether prunes that keep this fraction of the full list pay.
+fn pays(kept: f64) -> bool {
+    (1.0 - kept) * PRUNE_STEPS > PRUNE_COST
+}
 
 super::switch::switch!(
     /// Tests switch it on to keep the list full, to check that pruning
@@ -553,6 +571,27 @@ impl PairList {
         (2.0 * speed * PRUNE_STEPS).max(PRUNE_MIN * s.skin)
     }
 
+    /// Whether a prune at `step` is worth its cost ([`PRUNE_COST`]): the
+    /// last one dropped enough pairs that the force passes of the
+    /// [`PRUNE_STEPS`] steps it is chosen for walk fewer pairs by more than
+    /// it costs. A flowing scene (the chute) keeps most pairs within any
+    /// buffer its speeds allow, and its list then stays full, to be tried
+    /// again every [`PRUNE_RETRY`] builds (at a build: `step` is the last
+    /// build's), since a scene settles.
+    fn prune_pays(&mut self, step: i64) -> bool {
+        if self.kept == 0.0 || pays(self.kept) {
+            return true;
+        }
+        if step != self.last_build {
+            return false;
+        }
+        if self.retry_in == 0 {
+            return true;
+        }
+        self.retry_in -= 1;
+        false
+    }
+
     /// Keep of the full list the pairs within `buffer` beyond reach
     /// (touching plus the pair's `extra_range`) at the current positions,
     /// and every pair with history; or the full list when the buffer is too
@@ -567,7 +606,8 @@ impl PairList {
         let n = p.len();
         let mut x_pruned = vec![];
         let mut half = 0.0;
-        if buffer < PRUNE_MAX * s.skin && buffer > 0.0 && n > 0 && !NO_PRUNE.is_on() {
+        let listed = self.listed();
+        if buffer < PRUNE_MAX * s.skin && buffer > 0.0 && n > 0 && !NO_PRUNE.is_on() && self.prune_pays(step) {
             // positions in single precision and their largest rounding
             // error, which the check's limit leaves room for
             let mut eps2: f64 = 0.0;
@@ -599,6 +639,10 @@ impl PairList {
                 d.norm_squared() < reach * reach
             });
             self.images = images;
+            self.kept = self.a.len() as f64 / listed.max(1) as f64;
+            if !pays(self.kept) {
+                self.retry_in = PRUNE_RETRY;
+            }
             if self.outer.is_some() {
                 self.x_pruned = x_pruned;
                 self.prune_lim = half * half;
@@ -1148,6 +1192,53 @@ mod tests {
             let s = &adj[adj_start[i] as usize..adj_start[i + 1] as usize];
             assert!(s.windows(2).all(|w| (w[0] & !ADJ_B) < (w[1] & !ADJ_B)));
         }
+    }
+
+    #[test]
+    fn prunes_that_keep_most_pairs_stop_until_a_retry() {
+        let dom = Domain::new([0.0; 3], [4.0; 3], [[Side::Periodic; 2]; 3], 3);
+        let mut p = Particles::default();
+        let mut s = 5u64;
+        let mut u = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for t in 1..=800 {
+            p.push(part(t, V3::new(4.0 * u(), 4.0 * u(), 4.0 * u()), 0.1 + 0.05 * u()));
+        }
+        let settings = NeighSettings { skin: 0.2, ..Default::default() };
+        let mut pl = PairList::default();
+        // history on 5 pairs of 6: a prune keeps those, too many to pay
+        let flow = |pl: &mut PairList| {
+            for k in 0..pl.len() {
+                pl.hist[k] = if k % 6 == 0 { 0.0 } else { 1.0 };
+            }
+            pl.index(p.len());
+        };
+        pl.build(&p, &dom, &settings, 0, 1, |_, _| 0.0);
+        flow(&mut pl);
+        pl.prune(&p, &settings, 0.02, 0, &|_, _| 0.0);
+        assert!(pl.pruned() && pl.prunes == 1);
+        assert!(!pays(pl.kept) && pl.kept < 1.0, "kept {}", pl.kept);
+        // the next prune between builds is not worth it: the list is full
+        let m = pl.listed();
+        pl.prune(&p, &settings, 0.02, 5, &|_, _| 0.0);
+        assert!(!pl.pruned() && pl.prunes == 1 && pl.len() == m);
+        // nor at the next PRUNE_RETRY builds; the one after tries again
+        for b in 1..=PRUNE_RETRY as i64 + 1 {
+            pl.build(&p, &dom, &settings, 10 * b, 1, |_, _| 0.0);
+            if b == PRUNE_RETRY as i64 + 1 {
+                // the scene settled: most pairs lost their history
+                pl.hist.fill(0.0);
+                pl.index(p.len());
+            }
+            pl.prune(&p, &settings, 0.02, 10 * b, &|_, _| 0.0);
+            assert_eq!(pl.pruned(), b == PRUNE_RETRY as i64 + 1, "build {b}");
+        }
+        assert!(pl.prunes == 2 && pays(pl.kept), "kept {}", pl.kept);
+        // and prunes between builds pay again
+        pl.prune(&p, &settings, 0.02, 55, &|_, _| 0.0);
+        assert!(pl.pruned() && pl.prunes == 3);
     }
 
     #[test]
