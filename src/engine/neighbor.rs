@@ -202,6 +202,19 @@ pub fn without_pruning<T>(f: impl FnOnce() -> T) -> T {
     NO_PRUNE.on_during(f)
 }
 
+super::switch::switch!(
+    /// Tests switch it on to prune whenever the buffer allows, whether or
+    /// not the prune pays ([`PairList::prune_pays`]), so that a scene
+    /// small enough for a test prunes often.
+    EVERY_PRUNE
+);
+
+/// Run `f` pruning the pair list whenever the buffer allows, on this
+/// thread (tests).
+pub fn with_every_prune<T>(f: impl FnOnce() -> T) -> T {
+    EVERY_PRUNE.on_during(f)
+}
+
 /// Particles per block of the force pass. Fixed, never derived from the
 /// number of threads: the order in which contributions are added to each
 /// particle, and so every bit of the result, is the same on any thread count.
@@ -579,7 +592,7 @@ impl PairList {
     /// again every [`PRUNE_RETRY`] builds (at a build: `step` is the last
     /// build's), since a scene settles.
     fn prune_pays(&mut self, step: i64) -> bool {
-        if self.kept == 0.0 || pays(self.kept) {
+        if self.kept == 0.0 || pays(self.kept) || EVERY_PRUNE.is_on() {
             return true;
         }
         if step != self.last_build {
