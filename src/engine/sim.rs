@@ -470,7 +470,7 @@ impl Sim {
         self.hooks(&[Hook::InitialIntegrate], vars, &mut false, &mut stages)?;
         if UNFUSED.is_on() {
             // the check on its own, as tests compare
-            return Ok(self.pairs.travel_all(&self.particles.x, check));
+            return Ok(self.pairs.travel_all(&self.particles.x, check.then(|| self.neigh.skin_limit())));
         }
         Ok(self.fused(&mut stages, false, Some(check)))
     }
@@ -522,6 +522,7 @@ impl Sim {
             return Travel::default();
         }
         let cross = gather && !self.pairs.cross.is_empty();
+        let lim = check.then(|| self.neigh.skin_limit());
         let (pairs, defer) = (&self.pairs, &self.pair_defer[..]);
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, .. } = &mut self.particles;
         let n = x.len();
@@ -559,7 +560,7 @@ impl Sim {
                 st.apply(&mut c);
             }
             if measure {
-                pairs.travel(c.x, c.lo, check)
+                pairs.travel(c.x, c.lo, lim)
             } else {
                 Travel::default()
             }
