@@ -1263,18 +1263,28 @@ mod tests {
         }
     }
 
-    #[test]
-    fn skin_check_bounded_by_the_prune_decides_as_the_exact_one() {
-        let dom = Domain::new([0.0; 3], [4.0; 3], [[Side::Periodic; 2]; 3], 3);
-        let mut p = Particles::default();
-        let mut s = 9u64;
-        let mut u = || {
+    /// Uniform numbers in [0, 1) from `seed`.
+    fn lcg(mut s: u64) -> impl FnMut() -> f64 {
+        move || {
             s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        }
+    }
+
+    /// 800 spheres of radius 0.1-0.15 at random in a periodic box of side 4.
+    fn gas(u: &mut impl FnMut() -> f64) -> (Domain, Particles) {
+        let dom = Domain::new([0.0; 3], [4.0; 3], [[Side::Periodic; 2]; 3], 3);
+        let mut p = Particles::default();
         for t in 1..=800 {
             p.push(part(t, V3::new(4.0 * u(), 4.0 * u(), 4.0 * u()), 0.1 + 0.05 * u()));
         }
+        (dom, p)
+    }
+
+    #[test]
+    fn skin_check_bounded_by_the_prune_decides_as_the_exact_one() {
+        let mut u = lcg(9);
+        let (dom, mut p) = gas(&mut u);
         let settings = NeighSettings { skin: 0.2, ..Default::default() };
         let lim = settings.skin_limit();
         let mut pl = PairList::default();
@@ -1308,16 +1318,8 @@ mod tests {
 
     #[test]
     fn prunes_that_keep_most_pairs_stop_until_a_retry() {
-        let dom = Domain::new([0.0; 3], [4.0; 3], [[Side::Periodic; 2]; 3], 3);
-        let mut p = Particles::default();
-        let mut s = 5u64;
-        let mut u = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for t in 1..=800 {
-            p.push(part(t, V3::new(4.0 * u(), 4.0 * u(), 4.0 * u()), 0.1 + 0.05 * u()));
-        }
+        let mut u = lcg(5);
+        let (dom, p) = gas(&mut u);
         let settings = NeighSettings { skin: 0.2, ..Default::default() };
         let mut pl = PairList::default();
         // history on 5 pairs of 6: a prune keeps those, too many to pay
@@ -1355,16 +1357,8 @@ mod tests {
 
     #[test]
     fn prune_keeps_pairs_near_and_with_history_and_gives_them_back() {
-        let dom = Domain::new([0.0; 3], [4.0; 3], [[Side::Periodic; 2]; 3], 3);
-        let mut p = Particles::default();
-        let mut s = 3u64;
-        let mut u = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for t in 1..=800 {
-            p.push(part(t, V3::new(4.0 * u(), 4.0 * u(), 4.0 * u()), 0.1 + 0.05 * u()));
-        }
+        let mut u = lcg(3);
+        let (dom, mut p) = gas(&mut u);
         let settings = NeighSettings { skin: 0.2, ..Default::default() };
         let mut pl = PairList::default();
         pl.build(&p, &dom, &settings, 0, 2, |_, _| 0.0);
