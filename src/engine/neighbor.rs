@@ -474,14 +474,20 @@ impl PairList {
             let d = [x.x - p[0] as f64, x.y - p[1] as f64, x.z - p[2] as f64];
             d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
         };
-        t.pruned = x.iter().zip(xp).map(|(x, p)| d2(x, p)).fold(0.0, max);
-        if let Some(lim) = built {
-            // |x - x_built| <= |x - x_pruned| + |x_pruned - x_built|; the
-            // relative margin covers the rounding of both sides' sums
-            let bound = x.iter().zip(xp).map(|(x, p)| d2(x, p).sqrt() + p[3] as f64).fold(0.0, max);
-            let bound = bound * bound * (1.0 + 1e-9);
-            t.built = if bound <= lim { bound } else { exact(x) };
-        }
+        let Some(lim) = built else {
+            t.pruned = x.iter().zip(xp).map(|(x, p)| d2(x, p)).fold(0.0, max);
+            return t;
+        };
+        // |x - x_built| <= |x - x_pruned| + |x_pruned - x_built|; the
+        // relative margin covers the rounding of both sides' sums. One pass
+        // carries both maxima (each distance from the prune computed once).
+        let (pruned, bound) = x.iter().zip(xp).fold((0.0, 0.0), |(m, b), (x, p)| {
+            let d = d2(x, p);
+            (max(m, d), max(b, d.sqrt() + p[3] as f64))
+        });
+        let bound = bound * bound * (1.0 + 1e-9);
+        t.pruned = pruned;
+        t.built = if bound <= lim { bound } else { exact(x) };
         t
     }
 
