@@ -806,6 +806,21 @@ mod tests {
                 w
             };
             let w = if scalar { with_scalar_pass(|| pass(&mut f, &mut t, &mut defer, &mut pl)) } else { pass(&mut f, &mut t, &mut defer, &mut pl) };
+            // the pairs the pass found interacting are those that overlap
+            let overlap = (0..pl.a.len())
+                .filter(|&k| {
+                    let (i, j) = (pl.a[k] as usize, pl.b[k] as usize);
+                    let r = (p.x[i] - p.x[j] - pl.images[pl.image[k] as usize]).norm();
+                    p.radius[i] + p.radius[j] - r > 0.0
+                })
+                .count();
+            assert!(overlap > 50, "{overlap} contacts: too few to test");
+            if laws.noncontact() {
+                // and those apart within the cohesion's reach
+                assert!(pl.interacting() > overlap, "step {step}");
+            } else {
+                assert_eq!(pl.interacting(), overlap, "step {step}");
+            }
             let bits = |v: &[V3]| v.iter().flat_map(|x| x.iter().map(|c| c.to_bits())).collect::<Vec<u64>>();
             out.push((bits(&f), bits(&t), pl.hist.iter().map(|h| h.to_bits()).collect(), w.to_bits()));
             for i in 0..p.len() {

@@ -503,6 +503,12 @@ impl PairList {
         self.outer.is_some() && t.pruned > self.prune_lim
     }
 
+    /// Pairs that interacted in the last force pass: in contact, or within
+    /// the reach of a cohesion acting at a distance (the live flags).
+    pub fn interacting(&self) -> usize {
+        self.live.iter().take(self.a.len()).filter(|&&l| l & 1 != 0).count()
+    }
+
     /// Pairs of the last build: the full list's, while pruned.
     pub fn listed(&self) -> usize {
         self.outer.as_ref().map_or(self.a.len(), |o| o.a.len())

@@ -618,8 +618,9 @@ impl Sim {
         if n > 0 && np > 0 {
             let per = |m: f64| m / np as f64;
             s.push_str(&format!(
-                "Pairs per particle = {:.3} walked per step, {:.3} within the skin at the end\n",
+                "Pairs per particle = {:.3} walked per step; {:.3} interacting and {:.3} within the skin at the end\n",
                 per(self.walked as f64 / n as f64),
+                per(self.pairs.interacting() as f64),
                 per(self.pairs.listed() as f64)
             ));
         }
