@@ -5,6 +5,7 @@
 //!
 //!     cargo run --release --example law_floor
 use demx::engine::kernel::{contact_lanes, PairState};
+use demx::engine::rng::Park;
 use demx::physics::lanes::{BatchCoeffs, Vec3, F8, LANES};
 use demx::physics::mixing::{liggghts_beta, liggghts_g_eff, liggghts_y_eff};
 use demx::physics::normal::hertz::LiggghtsHertz;
@@ -24,13 +25,8 @@ fn main() {
         ..PairParams::default()
     };
     let coeffs = BatchCoeffs { p: [&pp; LANES], uniform: true };
-    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-    let mut rnd = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
+    let mut park = Park::new(12345);
+    let mut rnd = move || park.uniform() - 0.5;
     let (rad, mass) = (5e-4, 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * 1.25e-10);
     let mut lanes = |scale: f64, off: f64| F8(std::array::from_fn(|_| off + scale * rnd()));
     let nb = 64;
