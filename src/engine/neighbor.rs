@@ -22,6 +22,7 @@ use super::domain::Domain;
 use super::integrate::{in_chunks, CHUNK};
 use super::particles::Particles;
 use crate::physics::V3;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
@@ -144,11 +145,20 @@ pub struct Outer {
     keys: Vec<(i64, i64)>,
     /// Per pair: its index in the pruned list, or [`NONE`].
     inner: Vec<u32>,
-    /// Scratch of a prune: the pairs kept, and each one's index in the
-    /// list before (the list's length for none).
-    kept: Vec<u32>,
-    from: Vec<u32>,
+    /// Scratch of a prune: each pair's fate (1: kept).
+    keep: Vec<u8>,
+    /// The history buffer of the list before the last prune, reused by
+    /// the next one (which reads the current list's while it writes).
+    spare: Vec<f64>,
 }
+
+/// Pairs of the full list per chunk of a prune ([`PairList::refilter`]):
+/// fixed, so the list comes out the same on any thread count.
+const PRUNE_CHUNK: usize = 16384;
+
+/// One chunk of a prune's copy: its index, its places in the new list's
+/// arrays, and its pairs' slots in the full list.
+type PruneJob<'a> = (usize, &'a mut [u32], &'a mut [u32], &'a mut [u8], &'a mut [(i64, i64)], &'a mut [u8], &'a mut [f64], &'a mut [u32]);
 
 /// No index (a pair of the full list that the pruned list left out).
 const NONE: u32 = u32::MAX;
@@ -653,7 +663,7 @@ impl PairList {
     /// [`PairList::prune_due`]) and prune again if one did: so a pair left
     /// out stays beyond reach, where it would add nothing and keep no
     /// history.
-    pub fn prune<F: Fn(usize, usize) -> f64>(&mut self, p: &Particles, s: &NeighSettings, buffer: f64, step: i64, extra_range: &F) {
+    pub fn prune<F: Fn(usize, usize) -> f64 + Sync>(&mut self, p: &Particles, s: &NeighSettings, buffer: f64, step: i64, extra_range: &F) {
         let n = p.len();
         let mut x_pruned = vec![];
         let mut half = 0.0;
@@ -718,9 +728,11 @@ impl PairList {
     /// and live flags; the list is pruned after unless `near` kept every
     /// pair.
     ///
-    /// Two passes without a branch on the pairs' fate, which is a coin toss
-    /// in a bed: the first picks the pairs kept, the second copies them.
-    fn refilter(&mut self, near: impl Fn(usize, usize, u8) -> bool) {
+    /// Two passes over fixed chunks of the full list, in parallel, without
+    /// a branch on the pairs' fate, which is a coin toss in a bed: the
+    /// first decides each pair's fate and counts the chunk's kept pairs,
+    /// the second copies them to their places.
+    fn refilter(&mut self, near: impl Fn(usize, usize, u8) -> bool + Sync) {
         let w = self.width;
         // the pairs the list holds now
         let inner = self.a.len();
@@ -736,8 +748,8 @@ impl PairList {
                     image: std::mem::take(&mut self.image),
                     keys: std::mem::take(&mut self.keys),
                     inner: (0..m as u32).collect(),
-                    kept: vec![],
-                    from: vec![],
+                    keep: vec![],
+                    spare: vec![],
                 };
                 Box::new(o)
             }
@@ -749,37 +761,96 @@ impl PairList {
         self.live.push(0);
         self.hist.truncate(inner * w);
         self.hist.resize((inner + 1) * w, 0.0);
-        let Outer { a, b, image, keys, inner: slot, kept, from } = &mut *outer;
-        // every pair is written at the next place, which moves on when the
-        // pair is kept
-        // (kept from the last prune at their length: no clearing)
-        kept.resize(m, 0);
-        from.resize(m, 0);
-        let mut len = 0;
-        for k in 0..m {
-            let old = (slot[k] as usize).min(inner);
-            // both sides evaluated: no branch
-            let keep = (self.live[old] & 1 != 0) | near(a[k] as usize, b[k] as usize, image[k]);
-            kept[len] = k as u32;
-            from[len] = old as u32;
-            slot[k] = if keep { len as u32 } else { NONE };
-            len += keep as usize;
-        }
-        let (kept, from) = (&kept[..len], &from[..len]);
+        let Outer { a, b, image, keys, inner: slot, keep, spare } = &mut *outer;
+        let (a, b, image, keys) = (&a[..], &b[..], &image[..], &keys[..]);
         let (live, hist) = (&self.live, &self.hist);
-        let na: Vec<u32> = kept.iter().map(|&k| a[k as usize]).collect();
-        let nb: Vec<u32> = kept.iter().map(|&k| b[k as usize]).collect();
-        let ni: Vec<u8> = kept.iter().map(|&k| image[k as usize]).collect();
-        let nk: Vec<(i64, i64)> = kept.iter().map(|&k| keys[k as usize]).collect();
-        let nl: Vec<u8> = from.iter().map(|&q| live[q as usize]).collect();
-        let mut nh = Vec::with_capacity(len * w);
-        for &q in from {
-            // value by value: a copy of a few values of unknown count would
-            // be a call to memcpy per pair
-            for c in 0..w {
-                nh.push(hist[q as usize * w + c]);
+        // each pair's fate, and how many each chunk keeps
+        keep.resize(m, 0);
+        let fate = |c: usize, kc: &mut [u8]| -> usize {
+            let lo = c * PRUNE_CHUNK;
+            let mut n = 0;
+            for (q, kq) in kc.iter_mut().enumerate() {
+                let k = lo + q;
+                let old = (slot[k] as usize).min(inner);
+                // both sides evaluated: no branch
+                let kept = (live[old] & 1 != 0) | near(a[k] as usize, b[k] as usize, image[k]);
+                *kq = kept as u8;
+                n += kept as usize;
+            }
+            n
+        };
+        let counts: Vec<usize> = if m > PRUNE_CHUNK {
+            keep.par_chunks_mut(PRUNE_CHUNK).enumerate().map(|(c, kc)| fate(c, kc)).collect()
+        } else {
+            vec![fate(0, &mut keep[..])]
+        };
+        let len: usize = counts.iter().sum();
+        // the kept pairs, chunk by chunk at their places in the new list;
+        // the buffers of the list before are reused (no fresh pages)
+        let mut na = std::mem::take(&mut self.a);
+        let mut nb = std::mem::take(&mut self.b);
+        let mut ni = std::mem::take(&mut self.image);
+        let mut nk = std::mem::take(&mut self.keys);
+        let mut nl = vec![0u8; len];
+        let mut nh = std::mem::take(spare);
+        na.resize(len, 0);
+        nb.resize(len, 0);
+        ni.resize(len, 0);
+        nk.resize(len, (0, 0));
+        nh.clear();
+        nh.resize(len * w, 0.0);
+        let mut jobs = Vec::with_capacity(counts.len());
+        {
+            let (mut ra, mut rb, mut ri, mut rk, mut rl, mut rh) = (&mut na[..], &mut nb[..], &mut ni[..], &mut nk[..], &mut nl[..], &mut nh[..]);
+            let mut rs = &mut slot[..];
+            for (c, &n) in counts.iter().enumerate() {
+                let (ca, ta) = std::mem::take(&mut ra).split_at_mut(n);
+                let (cb, tb) = std::mem::take(&mut rb).split_at_mut(n);
+                let (ci, ti) = std::mem::take(&mut ri).split_at_mut(n);
+                let (ck, tk) = std::mem::take(&mut rk).split_at_mut(n);
+                let (cl, tl) = std::mem::take(&mut rl).split_at_mut(n);
+                let (ch, th) = std::mem::take(&mut rh).split_at_mut(n * w);
+                let cs_len = PRUNE_CHUNK.min(m - c * PRUNE_CHUNK);
+                let (cs, ts) = std::mem::take(&mut rs).split_at_mut(cs_len);
+                (ra, rb, ri, rk, rl, rh, rs) = (ta, tb, ti, tk, tl, th, ts);
+                jobs.push((c, ca, cb, ci, ck, cl, ch, cs));
             }
         }
+        let offsets: Vec<usize> = counts.iter().scan(0, |o, &n| Some(std::mem::replace(o, *o + n))).collect();
+        let keep = &keep[..];
+        let copy = |(c, ca, cb, ci, ck, cl, ch, cs): PruneJob<'_>| {
+            let (lo, off) = (c * PRUNE_CHUNK, offsets[c]);
+            // the kept pairs' indices and old places, branch-free: every
+            // pair is written at the next place, which moves on when kept
+            let mut from = vec![(0u32, 0u32); cs.len() + 1];
+            let mut t = 0;
+            for (q, s) in cs.iter_mut().enumerate() {
+                let k = lo + q;
+                let kept = keep[k] != 0;
+                from[t] = (k as u32, (*s as usize).min(inner) as u32);
+                *s = if kept { (off + t) as u32 } else { NONE };
+                t += kept as usize;
+            }
+            for (t, &(k, old)) in from[..ca.len()].iter().enumerate() {
+                let (k, old) = (k as usize, old as usize);
+                ca[t] = a[k];
+                cb[t] = b[k];
+                ci[t] = image[k];
+                ck[t] = keys[k];
+                cl[t] = live[old];
+                // value by value: a copy of a few values of unknown count
+                // would be a call to memcpy per pair
+                for v in 0..w {
+                    ch[t * w + v] = hist[old * w + v];
+                }
+            }
+        };
+        if jobs.len() > 1 {
+            jobs.into_par_iter().for_each(copy);
+        } else {
+            jobs.into_iter().for_each(copy);
+        }
+        *spare = std::mem::take(&mut self.hist);
         (self.a, self.b, self.image, self.keys, self.live, self.hist) = (na, nb, ni, nk, nl, nh);
         if len < m {
             self.outer = Some(outer);
@@ -1285,10 +1356,17 @@ mod tests {
 
     /// 800 spheres of radius 0.1-0.15 at random in a periodic box of side 4.
     fn gas(u: &mut impl FnMut() -> f64) -> (Domain, Particles) {
-        let dom = Domain::new([0.0; 3], [4.0; 3], [[Side::Periodic; 2]; 3], 3);
+        gas_of(u, 800)
+    }
+
+    /// `n` spheres of radius 0.1-0.15 at random in a periodic cube, as
+    /// dense as [`gas`].
+    fn gas_of(u: &mut impl FnMut() -> f64, n: i64) -> (Domain, Particles) {
+        let side = 4.0 * (n as f64 / 800.0).cbrt();
+        let dom = Domain::new([0.0; 3], [side; 3], [[Side::Periodic; 2]; 3], 3);
         let mut p = Particles::default();
-        for t in 1..=800 {
-            p.push(part(t, V3::new(4.0 * u(), 4.0 * u(), 4.0 * u()), 0.1 + 0.05 * u()));
+        for t in 1..=n {
+            p.push(part(t, V3::new(side * u(), side * u(), side * u()), 0.1 + 0.05 * u()));
         }
         (dom, p)
     }
@@ -1369,11 +1447,18 @@ mod tests {
 
     #[test]
     fn prune_keeps_pairs_near_and_with_history_and_gives_them_back() {
+        prune_keeps_in(800, false);
+        // a list of several chunks of the prune's parallel passes
+        prune_keeps_in(20_000, true);
+    }
+
+    fn prune_keeps_in(n: i64, chunks: bool) {
         let mut u = lcg(3);
-        let (dom, mut p) = gas(&mut u);
+        let (dom, mut p) = gas_of(&mut u, n);
         let settings = NeighSettings { skin: 0.2, ..Default::default() };
         let mut pl = PairList::default();
         pl.build(&p, &dom, &settings, 0, 2, |_, _| 0.0);
+        assert_eq!(pl.len() > 2 * PRUNE_CHUNK, chunks, "{} pairs", pl.len());
         // history on every 7th pair, touching or not
         for k in (0..pl.len()).step_by(7) {
             pl.hist[2 * k + 1] = k as f64 + 1.0;
