@@ -671,22 +671,32 @@ impl PairList {
         if buffer < PRUNE_MAX * s.skin && buffer > 0.0 && n > 0 && !NO_PRUNE.is_on() && self.x_built.len() == n && self.prune_pays(step) {
             // positions in single precision and their largest rounding
             // error, which the check's limit leaves room for
-            let mut eps2: f64 = 0.0;
-            x_pruned = p
-                .x
-                .iter()
-                .zip(&self.x_built)
-                .map(|(x, x0)| {
-                    let q = [x.x as f32, x.y as f32, x.z as f32];
-                    let d = [x.x - q[0] as f64, x.y - q[1] as f64, x.z - q[2] as f64];
-                    eps2 = eps2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                    // the distance from the build, rounded up twice over
-                    let e = [q[0] as f64 - x0.x, q[1] as f64 - x0.y, q[2] as f64 - x0.z];
-                    let e = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() * (1.0 + 1e-9);
-                    let up = e as f32;
-                    [q[0], q[1], q[2], if (up as f64) < e { up.next_up() } else { up }]
-                })
-                .collect();
+            // (in fixed chunks, in parallel; the largest error is a maximum,
+            // the same on any thread count)
+            let (x0, x) = (&self.x_built[..], &p.x[..]);
+            let parts = in_chunks(n, CHUNK, |r| {
+                let mut eps2: f64 = 0.0;
+                let xp: Vec<[f32; 4]> = x[r.clone()]
+                    .iter()
+                    .zip(&x0[r])
+                    .map(|(x, x0)| {
+                        let q = [x.x as f32, x.y as f32, x.z as f32];
+                        let d = [x.x - q[0] as f64, x.y - q[1] as f64, x.z - q[2] as f64];
+                        eps2 = eps2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                        // the distance from the build, rounded up twice over
+                        let e = [q[0] as f64 - x0.x, q[1] as f64 - x0.y, q[2] as f64 - x0.z];
+                        let e = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() * (1.0 + 1e-9);
+                        let up = e as f32;
+                        [q[0], q[1], q[2], if (up as f64) < e { up.next_up() } else { up }]
+                    })
+                    .collect();
+                (xp, eps2)
+            });
+            let eps2 = parts.iter().map(|c| c.1).fold(0.0, f64::max);
+            x_pruned = Vec::with_capacity(n);
+            for (xp, _) in &parts {
+                x_pruned.extend_from_slice(xp);
+            }
             // a relative margin for the rounding of the distances themselves
             half = 0.5 * buffer * (1.0 - 1e-9) - eps2.sqrt();
         }
@@ -1481,6 +1491,14 @@ mod tests {
         }
         assert_eq!(pl.prunes, 1);
         assert!(pl.pruned() && pl.indexed(p.len()));
+        // each particle's single-precision position, and a bound on its
+        // distance from the build (none moved yet: the rounding's)
+        assert_eq!(pl.x_pruned.len(), p.len());
+        for (q, x) in pl.x_pruned.iter().zip(&p.x) {
+            assert_eq!([q[0], q[1], q[2]], [x.x as f32, x.y as f32, x.z as f32]);
+            let e = V3::new(q[0] as f64, q[1] as f64, q[2] as f64) - x;
+            assert!(q[3] as f64 >= e.norm() && q[3] < 1e-6, "{q:?}");
+        }
         // the force pass changes history: a pair touching now gets some, and
         // every 7th loses its own (as pairs that came apart do)
         for q in 0..pl.len() {
