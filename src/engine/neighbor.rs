@@ -807,7 +807,9 @@ impl PairList {
         nb.resize(len, 0);
         ni.resize(len, 0);
         nk.resize(len, (0, 0));
-        nh.clear();
+        // every place is written below: only growth needs filling (a
+        // clear first would fill the whole history, serially)
+        nh.truncate(len * w);
         nh.resize(len * w, 0.0);
         let mut jobs = Vec::with_capacity(counts.len());
         {
@@ -943,63 +945,64 @@ impl PairList {
 
     /// [`PairList::index`] but for the live flags, which are set.
     fn index_blocks(&mut self, n: usize) {
-        let m = self.a.len();
         let bs = self.block_size();
         let nblocks = n.div_ceil(bs).max(1);
         // a particle's block by a shift, not a division (~25 cycles each, a
         // few per pair: most of this pass's time when a prune calls it)
         assert!(bs.is_power_of_two(), "force blocks of {bs} particles: not a power of two");
         let sh = bs.trailing_zeros();
-        self.block_start = vec![0; nblocks + 1];
-        for k in 0..m {
-            self.block_start[(self.a[k] as usize >> sh) + 1] += 1;
-        }
-        for q in 0..nblocks {
-            self.block_start[q + 1] += self.block_start[q];
-        }
-        // each block's cross pairs (those whose b lies in another block)
-        // get a range of slots, and each particle lists the slots where it
-        // is b, in increasing pair index (the order its shares are added)
-        let mut ccount = vec![0u32; n + 1];
-        self.block_cross = vec![0; nblocks + 1];
-        let mut ord = vec![u32::MAX; m];
-        let mut ncross = 0u32;
-        for k in 0..m {
-            let (a, b) = (self.a[k] as usize, self.b[k] as usize);
-            if a >> sh != b >> sh {
-                ccount[b + 1] += 1;
-                ord[k] = ncross;
-                ncross += 1;
-                self.block_cross[(a >> sh) + 1] += 1;
+        // the pairs are sorted by a: each block's are a range
+        debug_assert!(self.a.windows(2).all(|w| w[0] <= w[1]), "pairs not sorted by their first particle");
+        let a = &self.a[..];
+        self.block_start = (0..=nblocks).map(|q| a.partition_point(|&i| (i as usize >> sh) < q) as u32).collect();
+        // each block's cross pairs (those whose b lies in another block), in
+        // pair order, each with its place among them when sorted by b (then
+        // pair index): the slots of the block's range go in that order, so
+        // the cross pass, particle after particle, reads each block's range
+        // in order instead of at random. Blocks in parallel.
+        let (b, starts) = (&self.b[..], &self.block_start[..]);
+        let block = |q: usize| -> (Vec<u32>, Vec<u32>) {
+            let ks: Vec<u32> = (starts[q]..starts[q + 1]).filter(|&k| b[k as usize] as usize >> sh != q).collect();
+            let mut by_b: Vec<u32> = (0..ks.len() as u32).collect();
+            by_b.sort_by_key(|&c| b[ks[c as usize] as usize]);
+            let mut place = vec![0u32; ks.len()];
+            for (r, &c) in by_b.iter().enumerate() {
+                place[c as usize] = r as u32;
             }
+            (ks, place)
+        };
+        let per: Vec<(Vec<u32>, Vec<u32>)> =
+            if nblocks > 1 { (0..nblocks).into_par_iter().map(block).collect() } else { (0..nblocks).map(block).collect() };
+        self.block_cross = std::iter::once(0).chain(per.iter().scan(0u32, |c, (ks, _)| {
+            *c += ks.len() as u32;
+            Some(*c)
+        })).collect();
+        // the force pass finds the n-th cross pair of its walk at `xslot[n]`
+        self.xslot.clear();
+        for (_, place) in &per {
+            self.xslot.extend_from_slice(place);
         }
-        for q in 0..nblocks {
-            self.block_cross[q + 1] += self.block_cross[q];
+        // each particle lists the slots where it is b, in increasing pair
+        // index (the order its shares are added): blocks in order, each
+        // block's cross pairs in pair order
+        let mut ccount = vec![0u32; n + 1];
+        for (ks, _) in &per {
+            for &k in ks {
+                ccount[b[k as usize] as usize + 1] += 1;
+            }
         }
         for i in 0..n {
             ccount[i + 1] += ccount[i];
         }
         let mut fill = ccount.clone();
-        let mut by_b = vec![0u32; ncross as usize];
-        for k in 0..m {
-            if ord[k] != u32::MAX {
-                let b = self.b[k] as usize;
-                by_b[fill[b] as usize] = k as u32;
-                fill[b] += 1;
+        self.cross.clear();
+        self.cross.resize(self.xslot.len(), 0);
+        for (q, (ks, place)) in per.iter().enumerate() {
+            for (&k, &r) in ks.iter().zip(place) {
+                let i = b[k as usize] as usize;
+                self.cross[fill[i] as usize] = self.block_cross[q] + r;
+                fill[i] += 1;
             }
-        }
-        // within a block's range, slots go by b (then pair index): the cross
-        // pass, particle after particle, then reads each block's range in
-        // order instead of at random (the force pass finds a pair's slot in
-        // `xslot`, the n-th cross pair of the walk at `xslot[n]`)
-        let mut next = self.block_cross.clone();
-        self.xslot = vec![0; ncross as usize];
-        self.cross = vec![0; ncross as usize];
-        for (c, &k) in by_b.iter().enumerate() {
-            let q = self.a[k as usize] as usize >> sh;
-            self.cross[c] = next[q];
-            self.xslot[ord[k as usize] as usize] = next[q] - self.block_cross[q];
-            next[q] += 1;
         }
         self.cross_start = ccount;
     }
