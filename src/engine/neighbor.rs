@@ -971,8 +971,7 @@ impl PairList {
             }
             (ks, place)
         };
-        let per: Vec<(Vec<u32>, Vec<u32>)> =
-            if nblocks > 1 { (0..nblocks).into_par_iter().map(block).collect() } else { (0..nblocks).map(block).collect() };
+        let per = in_chunks(nblocks, 1, |r| block(r.start));
         self.block_cross = std::iter::once(0).chain(per.iter().scan(0u32, |c, (ks, _)| {
             *c += ks.len() as u32;
             Some(*c)
