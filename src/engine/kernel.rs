@@ -70,6 +70,10 @@ pub struct Laws<N, T, C, R> {
 pub trait ContactKernel: Send + Sync {
     /// History values per contact.
     fn history_width(&self) -> usize;
+    /// Each history value's factor when a pair's particles swap roles, in
+    /// storage order (normal, cohesion, tangential, rolling; see
+    /// `NormalLaw::FLIP`).
+    fn history_signs(&self) -> Vec<f64>;
     /// Whether pairs that do not touch interact (non-contact cohesion).
     fn noncontact(&self) -> bool;
     /// Force pass over the pair list, block by block (see [`Forces`]):
@@ -262,6 +266,9 @@ pub fn effective_mass<L: Real>(mi: L, mj: L) -> L {
 impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: RollingLaw + Send> ContactKernel for Laws<N, T, C, R> {
     fn history_width(&self) -> usize {
         Self::WIDTH
+    }
+    fn history_signs(&self) -> Vec<f64> {
+        [N::FLIP, C::FLIP, T::FLIP, R::FLIP].concat()
     }
     fn noncontact(&self) -> bool {
         C::NONCONTACT

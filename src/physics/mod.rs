@@ -200,6 +200,13 @@ pub struct PairParams {
 pub trait NormalLaw: Sync {
     /// History values this law keeps per contact.
     const HISTORY: usize;
+    /// The factor each history value takes when the pair's two particles
+    /// swap roles (i becomes j): -1.0 for a vector that points from one to
+    /// the other (a tangential displacement, a relative rotation), 1.0 for a
+    /// value both see alike (a flag, a magnitude). One per history value; the
+    /// pair list applies it when a pair's orientation changes across a
+    /// rebuild (its first particle is the one of smaller storage index).
+    const FLIP: &'static [f64] = &[];
     /// Whether the law acts only when the surfaces touch. Laws that keep a
     /// contact beyond touching (JKR) set it to false and decide in
     /// [`NormalLaw::active`]; the kernel then also hands them pairs that are
@@ -229,6 +236,13 @@ pub trait NormalLaw: Sync {
 pub trait TangentialLaw: Sync {
     /// History values per contact.
     const HISTORY: usize;
+    /// The factor each history value takes when the pair's two particles
+    /// swap roles (i becomes j): -1.0 for a vector that points from one to
+    /// the other (a tangential displacement, a relative rotation), 1.0 for a
+    /// value both see alike (a flag, a magnitude). One per history value; the
+    /// pair list applies it when a pair's orientation changes across a
+    /// rebuild (its first particle is the one of smaller storage index).
+    const FLIP: &'static [f64] = &[];
     /// Fill `ft`, add to `torque_i`, `torque_j`.
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
     /// Whether the law has a lane form.
@@ -244,6 +258,13 @@ pub trait TangentialLaw: Sync {
 pub trait CohesionLaw: Sync {
     /// History values per contact.
     const HISTORY: usize;
+    /// The factor each history value takes when the pair's two particles
+    /// swap roles (i becomes j): -1.0 for a vector that points from one to
+    /// the other (a tangential displacement, a relative rotation), 1.0 for a
+    /// value both see alike (a flag, a magnitude). One per history value; the
+    /// pair list applies it when a pair's orientation changes across a
+    /// rebuild (its first particle is the one of smaller storage index).
+    const FLIP: &'static [f64] = &[];
     /// Whether it acts on pairs that do not touch (vdW): the neighbour list
     /// and the kernel then include them.
     const NONCONTACT: bool;
@@ -262,6 +283,13 @@ pub trait CohesionLaw: Sync {
 pub trait RollingLaw: Sync {
     /// History values per contact.
     const HISTORY: usize;
+    /// The factor each history value takes when the pair's two particles
+    /// swap roles (i becomes j): -1.0 for a vector that points from one to
+    /// the other (a tangential displacement, a relative rotation), 1.0 for a
+    /// value both see alike (a flag, a magnitude). One per history value; the
+    /// pair list applies it when a pair's orientation changes across a
+    /// rebuild (its first particle is the one of smaller storage index).
+    const FLIP: &'static [f64] = &[];
     /// Add rolling/twisting torques to `torque_i` / `torque_j`.
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut);
     /// Whether the law has a lane form.
