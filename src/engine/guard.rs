@@ -633,7 +633,7 @@ mod tests {
         // a pair list as a contact model would have it (rebuild without a
         // model keeps none)
         let dom = sim.domain.clone().expect("box");
-        sim.pairs.build(&sim.particles, &dom, &sim.neigh, 0, 0, |_, _| 0.0);
+        sim.pairs.build(&sim.particles, &dom, &sim.neigh, 0, &[], |_, _| 0.0);
         sim.force_rebuild = false;
         sim
     }

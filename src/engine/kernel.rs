@@ -79,9 +79,26 @@ pub trait ContactKernel: Send + Sync {
     /// Force pass over the pair list, block by block (see [`Forces`]):
     /// sets each particle's force and torque to its pairs' sum (each block
     /// clears its particles' first, while they are in cache) and updates the
-    /// pairs' history; returns the pair virial, the sum of r_ij . F_ij.
-    /// Follow with [`cross_gather`].
-    fn force_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, force: Forces<'_>) -> f64;
+    /// pairs' history (`hist`, `live`: the list's own, taken out of it);
+    /// returns the pair virial, the sum of r_ij . F_ij.
+    ///
+    /// Without `tail`, follow with [`cross_gather`]. With one (only for a
+    /// list whose pairs reach forward, [`PairList::forward`]), each block
+    /// gets its cross shares and then `tail` as soon as the last pass that
+    /// reads or writes its particles is done; `tail` must change nothing but
+    /// the block's particles (see [`Tail`]).
+    #[allow(clippy::too_many_arguments)]
+    fn force_pass(
+        &self,
+        p: &PassState<'_>,
+        pairs: &PairList,
+        hist: &mut [f64],
+        live: &mut [u8],
+        table: &ParamTable,
+        dt: f64,
+        force: Forces<'_>,
+        tail: Option<&Tail<'_>>,
+    ) -> f64;
     /// One contact with a wall or any other partner given as a `Contact`;
     /// history is zeroed when apart. Returns the laws' output.
     fn contact(&self, c: &Contact, params: &PairParams, hist: &mut [f64]) -> ContactOut;
@@ -165,6 +182,38 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     }
 }
 
+/// What the force pass reads of the particles (whole arrays, by index).
+#[derive(Clone, Copy)]
+pub struct PassState<'a> {
+    /// Positions.
+    pub x: &'a [V3],
+    /// Velocities.
+    pub v: &'a [V3],
+    /// Angular velocities.
+    pub omega: &'a [V3],
+    /// Radii.
+    pub radius: &'a [f64],
+    /// Masses.
+    pub mass: &'a [f64],
+    /// Types.
+    pub kind: &'a [u32],
+    /// Frozen flags.
+    pub frozen: &'a [bool],
+}
+
+impl<'a> PassState<'a> {
+    /// The pass's view of `p`.
+    pub fn of(p: &'a Particles) -> PassState<'a> {
+        PassState { x: &p.x, v: &p.v, omega: &p.omega, radius: &p.radius, mass: &p.mass, kind: &p.kind, frozen: &p.frozen }
+    }
+}
+
+/// What the step does with a block once its forces are complete: called
+/// with the block's index and its particles' forces and torques. It may
+/// change the block's particles alone, and reads no other particle's
+/// position, velocity or angular velocity.
+pub type Tail<'a> = dyn Fn(usize, &mut [V3], &mut [V3]) + Sync + 'a;
+
 /// The state of the two particles of a pair that its contact is built from.
 #[derive(Clone, Copy)]
 pub struct PairState<L> {
@@ -222,7 +271,7 @@ pub fn contact_lanes<L: Real>(s: &PairState<L>, dt: f64) -> ContactL<L> {
 
 /// A particle's mass as its contacts see it: infinite when frozen.
 #[inline(always)]
-fn contact_mass(p: &Particles, k: usize) -> f64 {
+fn contact_mass(p: &PassState<'_>, k: usize) -> f64 {
     if p.frozen[k] {
         f64::INFINITY
     } else {
@@ -232,7 +281,7 @@ fn contact_mass(p: &Particles, k: usize) -> f64 {
 
 /// The state of pair (i, j) of one contact, j seen at `xj`.
 #[inline(always)]
-fn pair_state(p: &Particles, i: usize, j: usize, xj: V3) -> PairState<f64> {
+fn pair_state(p: &PassState<'_>, i: usize, j: usize, xj: V3) -> PairState<f64> {
     PairState {
         xi: p.x[i].into(),
         xj: xj.into(),
@@ -249,7 +298,7 @@ fn pair_state(p: &Particles, i: usize, j: usize, xj: V3) -> PairState<f64> {
 
 /// Build the contact of pair (i, j) where j is seen at `xj`.
 #[inline(always)]
-pub fn pair_contact(p: &Particles, i: usize, j: usize, xj: V3, dt: f64) -> Option<(Contact, f64)> {
+pub fn pair_contact(p: &PassState<'_>, i: usize, j: usize, xj: V3, dt: f64) -> Option<(Contact, f64)> {
     let r2 = (p.x[i] - xj).norm_squared();
     if r2 == 0.0 {
         return None;
@@ -268,7 +317,9 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         Self::WIDTH
     }
     fn history_signs(&self) -> Vec<f64> {
-        [N::FLIP, C::FLIP, T::FLIP, R::FLIP].concat()
+        let mut s = [N::FLIP, C::FLIP, T::FLIP, R::FLIP].concat();
+        s.resize(Self::WIDTH, 1.0); // TODO interim until every law states FLIP
+        s
     }
     fn noncontact(&self) -> bool {
         C::NONCONTACT
@@ -307,27 +358,37 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             out[k] = o.lane(k);
         }
     }
-    fn force_pass(&self, p: &Particles, pairs: &mut PairList, table: &ParamTable, dt: f64, force: Forces<'_>) -> f64 {
+    fn force_pass(
+        &self,
+        p: &PassState<'_>,
+        pairs: &PairList,
+        hist: &mut [f64],
+        live: &mut [u8],
+        table: &ParamTable,
+        dt: f64,
+        force: Forces<'_>,
+        tail: Option<&Tail<'_>>,
+    ) -> f64 {
         let m = pairs.len();
         let w = Self::WIDTH;
         let bs = pairs.block_size();
-        let n = p.len();
+        let n = p.x.len();
         let defer = force.defer;
         // one slot per cross pair; each block clears its slots first
         let ncross = pairs.block_cross.last().copied().unwrap_or(0) as usize;
         if defer.len() != ncross {
             defer.resize(ncross, [V3::zeros(); 2]);
         }
-        if pairs.live.len() != m {
-            pairs.live = vec![1; m];
-        }
-        let PairList { a, b, image, images, hist, live, block_start, block_cross, xslot, .. } = pairs;
+        assert!(live.len() == m && hist.len() == m * w, "pair flags or history not sized for the list");
+        let PairList { a, b, image, images, block_start, block_cross, xslot, .. } = pairs;
         let (a, b, image, images, block_start, block_cross, xslot) =
             (&a[..], &b[..], &image[..], &images[..], &block_start[..], &block_cross[..], &xslot[..]);
         // split the pairs' history and deferred slots at the block ranges
         let nblocks = block_start.len().saturating_sub(1);
         let mut jobs = Vec::with_capacity(nblocks);
-        let (mut hrest, mut drest, mut lrest) = (&mut hist[..], &mut defer[..], &mut live[..]);
+        // the deferred slots as the cross pass of a fused tail reads them
+        let slots = Shared(defer.as_mut_ptr() as *const [V3; 2]);
+        let (mut hrest, mut drest, mut lrest) = (hist, &mut defer[..], live);
         let (mut frest, mut trest) = (&mut force.f[..n], &mut force.torque[..n]);
         for q in 0..nblocks {
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
@@ -348,7 +409,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         // one block: its pairs in increasing index; both shares of a pair
         // inside the block are added at once, the share of a particle of
         // another block is kept for the cross pass
-        let block = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
+        let block = |(q, h, d, lv, f, tq): &mut Job<'_>| -> f64 {
+            let (q, h, d, lv, f, tq) = (*q, &mut **h, &mut **d, &mut **lv, &mut **f, &mut **tq);
             let lo = q * bs;
             let ps = block_start[q] as usize;
             // the block's n-th cross pair in pair order has slot xs[n]
@@ -400,7 +462,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             }
             virial
         };
-        let batched = |(q, h, d, lv, f, tq): Job<'_>| -> f64 {
+        let batched = |(q, h, d, lv, f, tq): &mut Job<'_>| -> f64 {
+            let (q, h, d, lv, f, tq) = (*q, &mut **h, &mut **d, &mut **lv, &mut **f, &mut **tq);
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
             d.fill([V3::zeros(); 2]);
             f.fill(V3::zeros());
@@ -409,11 +472,23 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             let blk = Block { p, a, b, image, images, xs, table, dt, lo: q * bs, ps, pe };
             self.block_batched(&blk, h, d, lv, f, tq)
         };
-        let virials: Vec<f64> = match (Self::BATCHED && !self.scalar_only(), nblocks > 1) {
-            (true, true) => jobs.into_par_iter().map(batched).collect(),
-            (true, false) => jobs.into_iter().map(batched).collect(),
-            (false, true) => jobs.into_par_iter().map(block).collect(),
-            (false, false) => jobs.into_iter().map(block).collect(),
+        let lanes = Self::BATCHED && !self.scalar_only();
+        let pass = |job: &mut Job<'_>| if lanes { batched(job) } else { block(job) };
+        let virials: Vec<f64> = match tail {
+            Some(tail) => {
+                let ncross = ncross;
+                fused_blocks(pairs, jobs, &pass, &|s: usize, f: &mut [V3], tq: &mut [V3]| {
+                    // SAFETY: the slots block `s` reads were written by
+                    // passes that are over (its dependency count reached
+                    // zero after their last write); no pass writes them
+                    // until this call returns
+                    let defer = unsafe { std::slice::from_raw_parts(slots.ptr(), ncross) };
+                    cross_gather_chunk(pairs, defer, s * bs, f, tq);
+                    tail(s, f, tq);
+                })
+            }
+            None if nblocks > 1 => jobs.par_iter_mut().map(pass).collect(),
+            None => jobs.iter_mut().map(pass).collect(),
         };
         virials.iter().sum()
     }
@@ -422,6 +497,72 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
 /// One block's share of the pass: its index, its pairs' history, deferred
 /// slots and live flags, and its particles' forces and torques.
 type Job<'a> = (usize, &'a mut [f64], &'a mut [[V3; 2]], &'a mut [u8], &'a mut [V3], &'a mut [V3]);
+
+/// A pointer the fused blocks share across threads (see [`fused_blocks`]).
+#[derive(Clone, Copy)]
+struct Shared<T>(*const T);
+// SAFETY: only read through, at times the dependency counts of
+// `fused_blocks` order after every write to what is read
+unsafe impl<T> Sync for Shared<T> {}
+unsafe impl<T> Send for Shared<T> {}
+
+impl<T> Shared<T> {
+    fn ptr(self) -> *const T {
+        self.0
+    }
+}
+
+/// Run each block's pass, and each block's `finish` as soon as every pass
+/// that touches its particles is done (its own and those of the earlier
+/// blocks whose pairs reach it: [`PairList::block_deps`]); returns the
+/// passes' virials in block order.
+///
+/// Passes are taken in block order by whichever thread is free; the thread
+/// whose pass brings a block's count to zero finishes that block. Each pass
+/// and each finish reads and writes the same things in any schedule, and
+/// what each adds is added in the same order, so the bits do not depend on
+/// the threads. On one thread this is pass, finish, pass, finish...: a
+/// block's particles are finished while the pass has left them in cache.
+fn fused_blocks<'a>(
+    pairs: &PairList,
+    jobs: Vec<Job<'a>>,
+    pass: &(dyn Fn(&mut Job<'a>) -> f64 + Sync),
+    finish: &(dyn Fn(usize, &mut [V3], &mut [V3]) + Sync),
+) -> Vec<f64> {
+    use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
+    use std::sync::{Mutex, PoisonError};
+    let nb = jobs.len();
+    let count: Vec<AtomicU32> = pairs.block_deps.iter().map(|&c| AtomicU32::new(c)).collect();
+    assert_eq!(count.len(), nb, "block dependencies not indexed for this list");
+    let virial: Vec<AtomicU64> = (0..nb).map(|_| AtomicU64::new(0)).collect();
+    let jobs: Vec<Mutex<Option<Job<'a>>>> = jobs.into_iter().map(|j| Mutex::new(Some(j))).collect();
+    let next = AtomicUsize::new(0);
+    let take = |q: usize| jobs[q].lock().unwrap_or_else(PoisonError::into_inner).take();
+    let work = || loop {
+        let q = next.fetch_add(1, Ordering::Relaxed);
+        if q >= nb {
+            break;
+        }
+        let Some(mut job) = take(q) else { unreachable!("block {q} passed twice") };
+        virial[q].store(pass(&mut job).to_bits(), Ordering::Relaxed);
+        *jobs[q].lock().unwrap_or_else(PoisonError::into_inner) = Some(job);
+        let touched = &pairs.block_touch[pairs.block_touch_start[q] as usize..pairs.block_touch_start[q + 1] as usize];
+        for s in std::iter::once(q).chain(touched.iter().map(|&s| s as usize)) {
+            // the last pass to touch block s releases it (AcqRel: every
+            // earlier pass's writes are seen by the finish)
+            if count[s].fetch_sub(1, Ordering::AcqRel) == 1 {
+                let Some((_, _, _, _, f, tq)) = take(s) else { unreachable!("block {s} finished twice") };
+                finish(s, f, tq);
+            }
+        }
+    };
+    if nb > 1 && rayon::current_num_threads() > 1 {
+        (0..rayon::current_num_threads()).into_par_iter().for_each(|_| work());
+    } else {
+        work();
+    }
+    virial.iter().map(|v| f64::from_bits(v.load(Ordering::Relaxed))).collect()
+}
 
 /// History values per contact the batched pass holds in lanes; wider
 /// combinations take the per-contact pass.
@@ -451,7 +592,7 @@ const WAS_LIVE: u8 = 4;
 
 /// What a block of the batched pass reads.
 struct Block<'a> {
-    p: &'a Particles,
+    p: &'a PassState<'a>,
     a: &'a [u32],
     b: &'a [u32],
     image: &'a [u8],
@@ -508,8 +649,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let pairs = k.a[k.ps..k.pe].iter().zip(&k.b[k.ps..k.pe]).zip(&k.image[k.ps..k.pe]);
         let last = k.pe.saturating_sub(1);
         for (q, ((&i, &j), &img)) in pairs.enumerate() {
-            // the partner a few pairs ahead: partners come by id, not by
-            // storage order, so their state is scattered in memory, and on
+            // the partner a few pairs ahead: partners lie later in storage,
+            // those across a block boundary often far later (the spatial
+            // order keeps most neighbours close in memory, not all), and on
             // beds beyond the cache each first touch of one waits on DRAM
             let ahead = k.b[(k.ps + q + PREFETCH_AHEAD).min(last)] as usize;
             prefetch(&p.x, ahead);
@@ -716,6 +858,43 @@ mod tests {
         fn tangential(&self, _: &Contact, _: &PairParams, _: &mut [f64], _: &mut ContactOut) {}
     }
 
+    /// A force pass of `laws` over `pl` and its cross pass, into `f`, `t`;
+    /// with `fused`, the cross shares come block by block through the
+    /// pass's tail instead (which copies each finished block out, so `f`
+    /// and `t` must be whole). Returns the virial.
+    #[allow(clippy::too_many_arguments)]
+    fn pass_and_gather(
+        laws: &dyn ContactKernel,
+        p: &Particles,
+        pl: &mut PairList,
+        table: &ParamTable,
+        f: &mut Vec<V3>,
+        t: &mut Vec<V3>,
+        defer: &mut Vec<[V3; 2]>,
+        fused: bool,
+    ) -> f64 {
+        let (mut hist, mut live) = pl.take_history();
+        let n = p.len();
+        let done = std::sync::Mutex::new((vec![V3::repeat(f64::NAN); n], vec![V3::repeat(f64::NAN); n], vec![0u32; n.div_ceil(pl.block_size())]));
+        let bs = pl.block_size();
+        let tail = |b: usize, fb: &mut [V3], tb: &mut [V3]| {
+            let mut d = done.lock().unwrap();
+            d.0[b * bs..b * bs + fb.len()].copy_from_slice(fb);
+            d.1[b * bs..b * bs + tb.len()].copy_from_slice(tb);
+            d.2[b] += 1;
+        };
+        let w = laws.force_pass(&PassState::of(p), pl, &mut hist, &mut live, table, 1e-3, Forces { f, torque: t, defer }, fused.then_some(&tail as &Tail<'_>));
+        pl.put_history(hist, live);
+        if fused {
+            let (df, dt, calls) = done.into_inner().unwrap();
+            assert!(calls.iter().all(|&c| c == 1), "each block finished once: {calls:?}");
+            (*f, *t) = (df, dt);
+        } else {
+            cross_gather(pl, defer, f, t);
+        }
+        w
+    }
+
     #[test]
     fn forces_are_equal_and_opposite_and_thread_count_independent() {
         let dom = Domain::new([0.0; 3], [3.0; 3], [[Side::Periodic; 2]; 3], 3);
@@ -739,24 +918,32 @@ mod tests {
         table.get_mut(1, 1).kn = 100.0;
         let laws = Laws { normal: Spring, tangential: Frictionless, cohesion: NoCohesion, rolling: NoRolling };
         // blocks of 64 particles: 7 blocks, many pairs across blocks
-        let run = |threads: usize, block: usize| {
+        let run_as = |threads: usize, block: usize, fused: bool| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let mut pl = PairList { block, ..Default::default() };
-                pl.build(&p, &dom, &NeighSettings { skin: 0.05, ..Default::default() }, 0, laws.history_width(), |_, _| 0.0);
+                pl.build(&p, &dom, &NeighSettings { skin: 0.05, ..Default::default() }, 0, &laws.history_signs(), |_, _| 0.0);
+                // pairs by storage index reach only later blocks
+                assert!(pl.forward && pl.a.iter().zip(&pl.b).all(|(a, b)| a <= b));
                 let mut defer = vec![];
                 let mut f = vec![V3::zeros(); p.len()];
                 let mut t = vec![V3::zeros(); p.len()];
-                let w = laws.force_pass(&p, &mut pl, &table, 1e-3, Forces { f: &mut f, torque: &mut t, defer: &mut defer });
-                cross_gather(&pl, &defer, &mut f, &mut t);
+                let w = pass_and_gather(&laws, &p, &mut pl, &table, &mut f, &mut t, &mut defer, fused);
                 assert!(block >= p.len() || !pl.cross.is_empty());
                 (f, pl.hist.clone(), w)
             })
         };
+        let run = |threads: usize, block: usize| run_as(threads, block, false);
         let (f1, h1, w1) = run(1, 64);
         let (f2, h2, w2) = run(2, 64);
         assert_eq!(f1, f2);
         assert_eq!(h1, h2);
+        // each block finished right after the passes that touch it: the
+        // same bits on one and two threads
+        for threads in [1, 2] {
+            let (ff, hf, wf) = run_as(threads, 64, true);
+            assert_eq!((&ff, &hf, wf.to_bits()), (&f1, &h1, w1.to_bits()), "fused on {threads} threads");
+        }
         assert_eq!(w1.to_bits(), w2.to_bits());
         // one block (no cross pairs) gives the same forces up to rounding
         let (f3, _, w3) = run(2, 4096);
@@ -803,14 +990,12 @@ mod tests {
         let settings = NeighSettings { skin: 0.05, ..Default::default() };
         let mut out = vec![];
         for step in 0..4 {
-            pl.build(&p, &dom, &settings, step, laws.history_width(), |_, _| 0.0);
+            pl.build(&p, &dom, &settings, step, &laws.history_signs(), |_, _| 0.0);
             let mut defer = vec![];
             let mut f = vec![V3::zeros(); p.len()];
             let mut t = vec![V3::zeros(); p.len()];
             let pass = |f: &mut Vec<V3>, t: &mut Vec<V3>, defer: &mut Vec<[V3; 2]>, pl: &mut PairList| {
-                let w = laws.force_pass(&p, pl, table, 1e-3, Forces { f, torque: t, defer });
-                cross_gather(pl, defer, f, t);
-                w
+                pass_and_gather(laws, &p, pl, table, f, t, defer, step % 2 == 1)
             };
             let w = if scalar { with_scalar_pass(|| pass(&mut f, &mut t, &mut defer, &mut pl)) } else { pass(&mut f, &mut t, &mut defer, &mut pl) };
             // the pairs the pass found interacting are those that overlap

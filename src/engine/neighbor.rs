@@ -1,10 +1,12 @@
 //! Binned Verlet pair list with skin, and contact history that survives
 //! rebuilds (LIGGGHTS `neighbor 0.002 bin`, `fix contact_history`).
 //!
-//! Each pair is stored once (a half list) with the particle of the smaller id
-//! first, so per-contact history always has the same orientation whatever the
-//! storage order; periodic images are an explicit shift of the second
-//! particle. History is carried across rebuilds keyed by the two ids.
+//! Each pair is stored once (a half list) with the particle of the smaller
+//! storage index first, so every force block's pairs reach only later blocks
+//! (the step may finish a block as soon as its own pass is done; see
+//! `Sim::one_step`); periodic images are an explicit shift of the second
+//! particle. History is carried across rebuilds keyed by the two ids, and
+//! turned (each law's `FLIP`) when storage order swapped a pair's roles.
 //! Per-particle adjacency (CSR) lists each particle's pairs in increasing pair
 //! index, so forces can be gathered in a fixed order on any thread count.
 //!
@@ -52,7 +54,7 @@ impl Hasher for IdHasher {
 /// The half pair list with history.
 #[derive(Clone, Debug, Default)]
 pub struct PairList {
-    /// First particle (smaller id) of each pair.
+    /// First particle (smaller storage index) of each pair.
     pub a: Vec<u32>,
     /// Second particle.
     pub b: Vec<u32>,
@@ -97,6 +99,19 @@ pub struct PairList {
     /// Per cross pair, in pair order: its slot, counted from its block's
     /// first ([`PairList::block_cross`]).
     pub xslot: Vec<u32>,
+    /// The other blocks each block's pairs reach, in increasing order, as
+    /// CSR offsets per block (blocks + 1) into `block_touch`.
+    pub block_touch_start: Vec<u32>,
+    /// See `block_touch_start`.
+    pub block_touch: Vec<u32>,
+    /// Per block, how many passes touch its particles: its own and those of
+    /// the blocks whose pairs reach it.
+    pub block_deps: Vec<u32>,
+    /// Whether every block's pairs reach only later blocks (pairs by storage
+    /// index, as every build makes them): then a block is complete once
+    /// its own pass and the earlier ones that reach it are done, and the
+    /// step finishes it right away (`kernel::fused_blocks`).
+    pub forward: bool,
     /// The full list of the last build while the list proper holds a
     /// pruned part of it ([`PairList::prune`]); `None`: the list is full.
     pub outer: Option<Box<Outer>>,
@@ -243,8 +258,9 @@ enum Carry {
         b: Vec<u32>,
         hist: Vec<f64>,
     },
-    /// Non-zero history by id pair.
-    ById(HashMap<(i64, i64), Vec<f64>, BuildHasherDefault<IdHasher>>),
+    /// Non-zero history by id pair, the smaller id first, with whether the
+    /// pair's first particle was the one of larger id.
+    ById(HashMap<(i64, i64), (bool, Vec<f64>), BuildHasherDefault<IdHasher>>),
 }
 
 /// The pairs whose first particle lies in `lo..lo + count.len()`.
@@ -292,9 +308,9 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
                 self.grid.stencil(ci, &mut stencil);
                 stencil_of = Some(ci);
             }
-            let (ti, xi, ri) = (p.tag[i], p.x[i], p.radius[i]);
+            let (xi, ri) = (p.x[i], p.radius[i]);
             // branch-free: every candidate is written, and the slot is kept
-            // when the pair is listed (the id test is a coin toss per
+            // when the pair is listed (the order test is a coin toss per
             // candidate, so a branch on it mispredicts half the time)
             let most: usize = stencil.iter().map(|r| (r.hi - r.lo) as usize).sum();
             if buf.len() < most {
@@ -305,10 +321,10 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
                 let shift = self.images[img as usize];
                 for &j in &self.grid.items[lo as usize..hi as usize] {
                     let ju = j as usize;
-                    // each pair once, from its smaller id; a particle's own
-                    // periodic images once, by the positive shift
-                    let tj = p.tag[ju];
-                    let order = (tj > ti) | ((tj == ti) & pos);
+                    // each pair once, from its smaller storage index; a
+                    // particle's own periodic images once, by the positive
+                    // shift
+                    let order = (ju > i) | ((ju == i) & pos);
                     let d = xi - (p.x[ju] + shift);
                     let reach = ri + p.radius[ju] + s.skin + (self.extra_range)(i, ju);
                     let within = d.norm_squared() < reach * reach;
@@ -543,18 +559,20 @@ impl PairList {
 
     /// Build the list. `extra_range(i, j)` is how far beyond touching the
     /// pair interacts (0 for contact-only models). History of pairs present
-    /// before is carried over by id.
+    /// before is carried over by id; `signs` has one factor per history
+    /// value (its width), applied where a pair's roles swapped since.
     ///
     /// Each particle collects, over the full 27-cell stencil, the neighbours
-    /// of larger id (and its own positive periodic images), sorted by storage
+    /// of larger storage index (and its own positive periodic images), sorted by storage
     /// index and shift: so the list comes out ordered by (a, b, shift) with no
     /// global sort, and fixed chunks of particles are built in parallel and
     /// joined in order (the same list on any thread count).
-    pub fn build<F>(&mut self, p: &Particles, dom: &Domain, s: &NeighSettings, step: i64, width: usize, extra_range: F)
+    pub fn build<F>(&mut self, p: &Particles, dom: &Domain, s: &NeighSettings, step: i64, signs: &[f64], extra_range: F)
     where
         F: Fn(usize, usize) -> f64 + Sync,
     {
         let n = p.len();
+        let width = signs.len();
         // a pruned list holds every pair with history: the carry reads it
         // as it reads a full one
         let listed = self.listed();
@@ -603,10 +621,19 @@ impl PairList {
             hist.extend_from_slice(&c.hist);
         }
         if let Some(old) = &by_id {
-            // storage changed since the last build: match history by id pair
+            // storage changed since the last build: match history by id
+            // pair, turned where the pair's first particle changed
             for k in 0..m {
-                if let Some(h) = old.get(&(p.tag[a[k] as usize], p.tag[b[k] as usize])) {
-                    hist[k * width..(k + 1) * width].copy_from_slice(h);
+                let (ta, tb) = (p.tag[a[k] as usize], p.tag[b[k] as usize]);
+                if let Some((was, h)) = old.get(&(ta.min(tb), ta.max(tb))) {
+                    let out = &mut hist[k * width..(k + 1) * width];
+                    if *was == (ta > tb) {
+                        out.copy_from_slice(h);
+                    } else {
+                        for ((o, &v), &sign) in out.iter_mut().zip(h).zip(signs) {
+                            *o = v * sign;
+                        }
+                    }
                 }
             }
         }
@@ -914,12 +941,12 @@ impl PairList {
             }
             return Carry::ByIndex { start, b: std::mem::take(&mut self.b), hist: std::mem::take(&mut self.hist) };
         }
-        let mut old: HashMap<(i64, i64), Vec<f64>, BuildHasherDefault<IdHasher>> = HashMap::default();
+        let mut old: HashMap<(i64, i64), (bool, Vec<f64>), BuildHasherDefault<IdHasher>> = HashMap::default();
         for (k, h) in self.hist.chunks_exact(width).enumerate() {
             if h.iter().any(|&v| v != 0.0) {
-                if let Some(&key) = self.keys.get(k) {
+                if let Some(&(ta, tb)) = self.keys.get(k) {
                     // of two images of one pair, the later one is kept
-                    old.insert(key, h.to_vec());
+                    old.insert((ta.min(tb), ta.max(tb)), (ta > tb, h.to_vec()));
                 }
             }
         }
@@ -1004,6 +1031,26 @@ impl PairList {
             }
         }
         self.cross_start = ccount;
+        // which blocks each block's pairs reach
+        self.block_touch_start.clear();
+        self.block_touch_start.push(0);
+        self.block_touch.clear();
+        self.block_deps.clear();
+        self.block_deps.resize(nblocks, 1);
+        self.forward = true;
+        let mut reach: Vec<u32> = Vec::new();
+        for (q, (ks, _)) in per.iter().enumerate() {
+            reach.clear();
+            reach.extend(ks.iter().map(|&k| (b[k as usize] as usize >> sh) as u32));
+            reach.sort_unstable();
+            reach.dedup();
+            for &r in &reach {
+                self.forward &= r as usize > q;
+                self.block_deps[r as usize] += 1;
+            }
+            self.block_touch.extend_from_slice(&reach);
+            self.block_touch_start.push(self.block_touch.len() as u32);
+        }
     }
 
     /// Each particle's pairs in increasing pair index, as CSR offsets per
@@ -1030,6 +1077,21 @@ impl PairList {
             fill[b] += 1;
         }
         (start, adj)
+    }
+
+    /// The pairs' history and live flags, taken out of the list for a force
+    /// pass (the flags set for every pair if they are not sized for the
+    /// list); [`PairList::put_history`] gives them back.
+    pub fn take_history(&mut self) -> (Vec<f64>, Vec<u8>) {
+        if self.live.len() != self.a.len() {
+            self.live = vec![1; self.a.len()];
+        }
+        (std::mem::take(&mut self.hist), std::mem::take(&mut self.live))
+    }
+
+    /// Give back what [`PairList::take_history`] took.
+    pub fn put_history(&mut self, hist: Vec<f64>, live: Vec<u8>) {
+        (self.hist, self.live) = (hist, live);
     }
 
     /// Whether the list is indexed for `n` particles.
@@ -1298,9 +1360,8 @@ mod tests {
                             let s = V3::new(sx as f64 * l[0], sy as f64 * l[1], sz as f64 * l[2]);
                             let d = p.x[i] - (p.x[j] + s);
                             if d.norm() < p.radius[i] + p.radius[j] + skin {
-                                let (ta, tb, sh) =
-                                    if p.tag[i] <= p.tag[j] { (p.tag[i], p.tag[j], sh) } else { (p.tag[j], p.tag[i], [-sx, -sy, -sz]) };
-                                out.push((ta, tb, sh));
+                                // the smaller storage index first
+                                out.push((p.tag[i], p.tag[j], sh));
                             }
                         }
                     }
@@ -1337,7 +1398,7 @@ mod tests {
         }
         let s = NeighSettings { skin: 0.1, ..Default::default() };
         let mut pl = PairList::default();
-        pl.build(&p, &dom, &s, 0, 2, |_, _| 0.0);
+        pl.build(&p, &dom, &s, 0, &[1.0; 2], |_, _| 0.0);
         let l = dom.lengths();
         let mut got: Vec<(i64, i64, [i64; 3])> = (0..pl.len())
             .map(|k| {
@@ -1390,7 +1451,7 @@ mod tests {
         let settings = NeighSettings { skin: 0.2, ..Default::default() };
         let lim = settings.skin_limit();
         let mut pl = PairList::default();
-        pl.build(&p, &dom, &settings, 0, 1, |_, _| 0.0);
+        pl.build(&p, &dom, &settings, 0, &[1.0], |_, _| 0.0);
         let x0 = p.x.clone();
         let mut trials = [0; 2];
         for round in 0..200 {
@@ -1431,7 +1492,7 @@ mod tests {
             }
             pl.index(p.len());
         };
-        pl.build(&p, &dom, &settings, 0, 1, |_, _| 0.0);
+        pl.build(&p, &dom, &settings, 0, &[1.0], |_, _| 0.0);
         flow(&mut pl);
         pl.prune(&p, &settings, 0.02, 0, &|_, _| 0.0);
         assert!(pl.pruned() && pl.prunes == 1);
@@ -1442,7 +1503,7 @@ mod tests {
         assert!(!pl.pruned() && pl.prunes == 1 && pl.len() == m);
         // nor at the next PRUNE_RETRY builds; the one after tries again
         for b in 1..=PRUNE_RETRY as i64 + 1 {
-            pl.build(&p, &dom, &settings, 10 * b, 1, |_, _| 0.0);
+            pl.build(&p, &dom, &settings, 10 * b, &[1.0], |_, _| 0.0);
             if b == PRUNE_RETRY as i64 + 1 {
                 // the scene settled: most pairs lost their history
                 pl.hist.fill(0.0);
@@ -1469,7 +1530,7 @@ mod tests {
         let (dom, mut p) = gas_of(&mut u, n);
         let settings = NeighSettings { skin: 0.2, ..Default::default() };
         let mut pl = PairList::default();
-        pl.build(&p, &dom, &settings, 0, 2, |_, _| 0.0);
+        pl.build(&p, &dom, &settings, 0, &[1.0; 2], |_, _| 0.0);
         assert_eq!(pl.len() > 2 * PRUNE_CHUNK, chunks, "{} pairs", pl.len());
         // history on every 7th pair, touching or not
         for k in (0..pl.len()).step_by(7) {
@@ -1541,15 +1602,30 @@ mod tests {
         p.push(part(3, V3::new(1.9, 1.0, 1.0), 0.5));
         p.push(part(5, V3::new(5.0, 5.0, 5.0), 0.5));
         let s = NeighSettings::default();
+        let signs = [-1.0, 1.0, -1.0];
         let mut pl = PairList::default();
-        pl.build(&p, &dom, &s, 0, 3, |_, _| 0.0);
+        pl.build(&p, &dom, &s, 0, &signs, |_, _| 0.0);
         assert_eq!(pl.len(), 1);
-        assert_eq!(p.tag[pl.a[0] as usize], 3); // smaller id first
+        assert_eq!(p.tag[pl.a[0] as usize], 7); // smaller storage index first
         pl.hist.copy_from_slice(&[1.0, 2.0, 3.0]);
+        // storage unchanged: carried by index, as it was
+        pl.build(&p, &dom, &s, 5, &signs, |_, _| 0.0);
+        assert_eq!(pl.hist, vec![1.0, 2.0, 3.0]);
+        // reversed storage: the pair's roles swap and its history turns
         p.permute(&[2, 1, 0]);
-        pl.build(&p, &dom, &s, 10, 3, |_, _| 0.0);
+        pl.build(&p, &dom, &s, 10, &signs, |_, _| 0.0);
         assert_eq!(pl.len(), 1);
         assert_eq!(p.tag[pl.a[0] as usize], 3);
+        assert_eq!(pl.hist, vec![-1.0, 2.0, -3.0]);
+        // reordered without a swap (the far particle moves): kept by id as is
+        p.permute(&[1, 2, 0]);
+        pl.build(&p, &dom, &s, 20, &signs, |_, _| 0.0);
+        assert_eq!(p.tag[pl.a[0] as usize], 3);
+        assert_eq!(pl.hist, vec![-1.0, 2.0, -3.0]);
+        // and back: turned back to what it was
+        p.permute(&[1, 0, 2]);
+        pl.build(&p, &dom, &s, 30, &signs, |_, _| 0.0);
+        assert_eq!(p.tag[pl.a[0] as usize], 7);
         assert_eq!(pl.hist, vec![1.0, 2.0, 3.0]);
     }
 }

@@ -3,7 +3,7 @@
 use super::compute::Compute;
 use super::domain::Domain;
 use super::fix::{Chunk, Fix, Hole, Hook, Local, Stage};
-use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable};
+use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable, PassState};
 use super::neighbor::{Due, NeighSettings, PairList, Travel};
 use super::output::{Dump, Logger, Thermo};
 use super::particles::Particles;
@@ -27,6 +27,21 @@ super::switch::switch!(
 /// Run `f` with the step's head and tail unfused on this thread (tests).
 pub fn with_unfused_tail<T>(f: impl FnOnce() -> T) -> T {
     UNFUSED.on_during(f)
+}
+
+/// A pointer the fused pass's blocks share across threads
+/// ([`Sim::fused_pass`]).
+#[derive(Clone, Copy)]
+struct Raw<T>(*mut T);
+// SAFETY: each block's entries are written by one finish at a time, after
+// every read of them by a pass (see `Sim::fused_pass`)
+unsafe impl<T> Sync for Raw<T> {}
+unsafe impl<T> Send for Raw<T> {}
+
+impl<T> Raw<T> {
+    fn ptr(self) -> *mut T {
+        self.0
+    }
 }
 
 /// Which engine's conventions a deck follows.
@@ -106,6 +121,9 @@ pub struct Sim {
     pub last_rate: f64,
     /// Time spent per section of the last run: pair, neigh, modify, output.
     pub timing: [f64; 4],
+    /// Time the current step's pair pass took (part of its tail when the
+    /// two run fused; see [`Sim::fused_pass`]).
+    pass_secs: f64,
     /// Pairs the force passes of the current run walked, summed over steps.
     pub walked: u64,
     /// The state came from a restart file: the next run starts from the
@@ -152,6 +170,7 @@ impl Default for Sim {
             boltz: 1.380649e-23,
             last_rate: 0.0,
             timing: [0.0; 4],
+            pass_secs: 0.0,
             walked: 0,
             resume: false,
             sort_every: 1000,
@@ -231,7 +250,7 @@ impl Sim {
                 p.permute(&order);
             }
         }
-        let width = self.model.as_ref().map_or(0, |m| m.kernel.history_width());
+        let signs = self.model.as_ref().map_or(vec![], |m| m.kernel.history_signs());
         // chosen from the travel since the last build or prune, before the build
         let buffer = self.pairs.next_buffer(&self.neigh, self.step);
         let table = self.model.as_ref().map(|m| &m.table);
@@ -240,9 +259,9 @@ impl Sim {
         match table {
             Some(t) if t.max_extra_range() > 0.0 => {
                 let kinds = &p.kind;
-                self.pairs.build(p, dom, &self.neigh, self.step, width, |i, j| t.get(kinds[i], kinds[j]).extra_range)
+                self.pairs.build(p, dom, &self.neigh, self.step, &signs, |i, j| t.get(kinds[i], kinds[j]).extra_range)
             }
-            Some(_) => self.pairs.build(p, dom, &self.neigh, self.step, width, |_, _| 0.0),
+            Some(_) => self.pairs.build(p, dom, &self.neigh, self.step, &signs, |_, _| 0.0),
             None => {
                 // no pair style: no pairs, but keep the skin bookkeeping
                 self.pairs = PairList { x_built: p.x.clone(), last_build: self.step, ..Default::default() };
@@ -293,10 +312,99 @@ impl Sim {
         };
         // the force pass clears the forces block by block
         let (mut f, mut torque) = (std::mem::take(&mut p.f), std::mem::take(&mut p.torque));
+        let (mut hist, mut live) = self.pairs.take_history();
         let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer };
-        self.pair_virial = m.kernel.force_pass(&self.particles, &mut self.pairs, &m.table, dt, force);
+        self.pair_virial = m.kernel.force_pass(&PassState::of(&self.particles), &self.pairs, &mut hist, &mut live, &m.table, dt, force, None);
+        self.pairs.put_history(hist, live);
         let p = &mut self.particles;
         (p.f, p.torque) = (f, torque);
+    }
+
+    /// Whether the step's pair pass may run fused with its tail
+    /// ([`Sim::fused_pass`]).
+    fn fusable(&self) -> bool {
+        let n = self.particles.len();
+        self.model.is_some() && n > 0 && self.pairs.forward && self.pairs.indexed(n) && self.pairs.block_deps.len() == n.div_ceil(self.pairs.block_size()) && !UNFUSED.is_on()
+    }
+
+    /// The step's pair pass fused with the tail that follows it (the cross
+    /// shares, then `stages`, then with `Some(check)` the travel, as
+    /// [`Sim::fused`]): each force block is finished as soon as every pass
+    /// that touches its particles is done, so on one thread a block's
+    /// particles pass through the cache once per step instead of twice (the
+    /// pairs reach only later blocks: [`PairList::forward`]). Each particle
+    /// meets the same operations in the same order as in the pass and then
+    /// the tail, so the bits are theirs.
+    fn fused_pass(&mut self, stages: &mut Vec<Box<dyn Stage>>, measure: Option<bool>) -> Travel {
+        use std::sync::atomic::{AtomicU64, Ordering};
+        use std::sync::{Mutex, PoisonError};
+        let start = Instant::now();
+        let check = measure == Some(true);
+        let measure = check || (measure.is_some() && self.pairs.pruned());
+        let lim = check.then(|| self.neigh.skin_limit());
+        let (mut hist, mut live) = self.pairs.take_history();
+        let Some(m) = &self.model else { unreachable!("fused pass without a pair model") };
+        let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, frozen, .. } = &mut self.particles;
+        let n = x.len();
+        let (mut fv, mut tv) = (std::mem::take(f), std::mem::take(torque));
+        let (xp, vp, wp) = (Raw(x.as_mut_ptr()), Raw(v.as_mut_ptr()), Raw(omega.as_mut_ptr()));
+        let cols: Vec<(Raw<f64>, usize)> = extra.iter_mut().map(|e| (Raw(e.data.as_mut_ptr()), e.width)).collect();
+        let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
+        // SAFETY: while the pass runs, positions, velocities and angular
+        // velocities are read through these and written only by `tail`,
+        // each block's after every pass that reads them is over (the
+        // dependency counts of `kernel::fused_blocks`), and by no one else
+        let state = unsafe {
+            PassState {
+                x: std::slice::from_raw_parts(xp.ptr(), n),
+                v: std::slice::from_raw_parts(vp.ptr(), n),
+                omega: std::slice::from_raw_parts(wp.ptr(), n),
+                radius,
+                mass,
+                kind,
+                frozen,
+            }
+        };
+        let bs = self.pairs.block_size();
+        let nblocks = n.div_ceil(bs);
+        let moved: Vec<Mutex<Travel>> = (0..nblocks).map(|_| Mutex::new(Travel::default())).collect();
+        let tail_ns = AtomicU64::new(0);
+        let (pairs, pending) = (&self.pairs, &*stages);
+        let tail = |s: usize, f: &mut [V3], torque: &mut [V3]| {
+            let t = Instant::now();
+            let (lo, len) = (s * bs, f.len());
+            // SAFETY: block s's entries, which no pass reads any more and no
+            // other finish touches (see `state`)
+            let (x, v, omega, extra) = unsafe {
+                (
+                    std::slice::from_raw_parts_mut(xp.ptr().add(lo), len),
+                    std::slice::from_raw_parts_mut(vp.ptr().add(lo), len),
+                    std::slice::from_raw_parts_mut(wp.ptr().add(lo), len),
+                    cols.iter().map(|&(c, w)| std::slice::from_raw_parts_mut(c.ptr().add(lo * w), len * w)).collect(),
+                )
+            };
+            let mut c = Chunk { lo, x, radius, mass, kind, mask, v, omega, f, torque, extra };
+            for st in pending {
+                st.apply(&mut c);
+            }
+            if measure {
+                *moved[s].lock().unwrap_or_else(PoisonError::into_inner) = pairs.travel(c.x, lo, lim);
+            }
+            tail_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        };
+        let force = Forces { f: &mut fv, torque: &mut tv, defer: &mut self.pair_defer };
+        let virial = m.kernel.force_pass(&state, pairs, &mut hist, &mut live, &m.table, self.dt, force, Some(&tail));
+        self.pair_virial = virial;
+        self.pairs.put_history(hist, live);
+        (self.particles.f, self.particles.torque) = (fv, tv);
+        stages.clear();
+        // the pass's share of the time: the whole less the finishes' (their
+        // time summed over the threads, which ran them side by side)
+        let threads = if nblocks > 1 { rayon::current_num_threads() } else { 1 };
+        let tails = tail_ns.load(Ordering::Relaxed) as f64 * 1e-9 / threads as f64;
+        self.pass_secs += (start.elapsed().as_secs_f64() - tails).max(0.0);
+        // maxima over the blocks: the same on any thread count
+        moved.into_iter().map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner)).fold(Travel::default(), Travel::max)
     }
 
     /// Forces at the start of a run (LAMMPS `Verlet::setup`).
@@ -386,10 +494,10 @@ impl Sim {
             self.prune(self.pairs.next_buffer(&self.neigh, step));
         }
         let t2 = Instant::now();
-        self.pair_pass(self.dt);
         self.walked += self.pairs.a.len() as u64;
-        let t3 = Instant::now();
-        // the step's tail: the cross-block shares of the pair forces, then
+        self.pass_secs = 0.0;
+        // the step's tail: the pair pass (at the first hook that needs the
+        // forces, or fused with the stages before it), the cross-block shares of the pair forces, then
         // every fix's post_force, then every fix's final_integrate, in
         // LAMMPS order. Hooks that act particle by particle ([`Fix::local`])
         // run fused, chunk by chunk, so a bed's forces and velocities pass
@@ -420,9 +528,9 @@ impl Sim {
             self.output(vars, false)?;
         }
         let secs = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64();
-        self.timing[0] += secs(t2, t3);
+        self.timing[0] += self.pass_secs;
         self.timing[1] += secs(t1, t2);
-        self.timing[2] += secs(t0, t1) + secs(t3, t4);
+        self.timing[2] += secs(t0, t1) + (secs(t2, t4) - self.pass_secs).max(0.0);
         if next.is_none() {
             self.timing[3] += t4.elapsed().as_secs_f64();
         }
@@ -510,12 +618,22 @@ impl Sim {
         Ok(())
     }
 
-    /// Run the cross pass (when `gather`), then `stages`, then, with
+    /// Run the step's pair pass and its cross pass (when `gather`; fused
+    /// with what follows where [`Sim::fusable`]), then `stages`, then, with
     /// `Some(check)`, measure the travel (since the last build when
     /// `check`, since the last prune while the list is pruned; returned)
     /// over the particles in fixed chunks, in parallel from two chunks up;
     /// empties `stages`.
     fn fused(&mut self, stages: &mut Vec<Box<dyn Stage>>, gather: bool, measure: Option<bool>) -> Travel {
+        if gather {
+            // the step's pair pass is still to run
+            if self.fusable() {
+                return self.fused_pass(stages, measure);
+            }
+            let t = Instant::now();
+            self.pair_pass(self.dt);
+            self.pass_secs += t.elapsed().as_secs_f64();
+        }
         let check = measure == Some(true);
         let measure = check || (measure.is_some() && self.pairs.pruned());
         if stages.is_empty() && !gather && !measure {
