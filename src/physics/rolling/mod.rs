@@ -41,12 +41,15 @@ pub(crate) fn liggghts_rotation_lanes<R: Real>(c: &ContactL<R>) -> (Vec3<R>, R) 
 }
 
 /// LIGGGHTS rolling inertia I_r (3D): 1.4 m R^2 for walls, else
-/// 1.4 (mi ri^2)(mj rj^2)/(mi ri^2 + mj rj^2).
+/// 1.4 (mi ri^2)(mj rj^2)/(mi ri^2 + mj rj^2); a frozen particle (infinite
+/// mass) on either side leaves the other's 1.4 m R^2, as a wall does.
 #[inline(always)]
 pub(crate) fn liggghts_rolling_inertia(c: &Contact) -> f64 {
     let ii = c.mi * c.ri * c.ri;
     if c.is_wall() || c.mj.is_infinite() {
         1.4 * ii
+    } else if c.mi.is_infinite() {
+        1.4 * (c.mj * c.rj * c.rj)
     } else {
         let ij = c.mj * c.rj * c.rj;
         1.4 * ii * ij / (ii + ij)
