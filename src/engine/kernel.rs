@@ -846,6 +846,8 @@ mod tests {
     struct Spring;
     impl NormalLaw for Spring {
         const HISTORY: usize = 1;
+        /// A count of the pair's passes, the same from both sides.
+        const FLIP: &'static [f64] = &[1.0];
         fn normal(&self, c: &Contact, p: &PairParams, h: &mut [f64], out: &mut ContactOut) {
             h[0] += 1.0;
             out.fn_elastic = p.kn * c.delta;

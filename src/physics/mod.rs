@@ -587,3 +587,69 @@ pub fn on_one(c: &Contact, out: &mut ContactOut, f: impl FnOnce(&ContactL<f64>, 
     f(&cl, &mut o);
     *out = o.into();
 }
+
+/// Every law's [`NormalLaw::FLIP`] (and the others') has one factor per
+/// history value, each +1 or -1: checked when the crate compiles. The test
+/// below keeps the list complete.
+macro_rules! check_flip {
+    ($($law:ident: $($ty:ty),+;)+) => {
+        const _: () = {
+            $($(
+                let (flip, n) = (<$ty as $law>::FLIP, <$ty as $law>::HISTORY);
+                assert!(flip.len() == n, concat!(stringify!($ty), ": FLIP needs one factor per history value"));
+                let mut k = 0;
+                while k < flip.len() {
+                    assert!(flip[k] == 1.0 || flip[k] == -1.0, concat!(stringify!($ty), ": a FLIP factor is +1 or -1"));
+                    k += 1;
+                }
+            )+)+
+        };
+        /// The laws [`check_flip`] checks, by name.
+        #[cfg(test)]
+        const CHECKED_LAWS: &[&str] = &[$($(stringify!($ty)),+),+];
+    };
+}
+
+check_flip! {
+    NormalLaw: normal::hooke::LiggghtsHooke, normal::hooke_stiffness::LiggghtsHookeStiffness, normal::hertz::LiggghtsHertz,
+        normal::hertz_stiffness::LiggghtsHertzStiffness, normal::viscoelastic::PaperViscoelastic, normal::gran::LammpsGranHooke,
+        normal::gran::LammpsGranHertz, normal::granular::LammpsGranular, normal::dmt::LammpsDmt, normal::jkr::LammpsJkr;
+    TangentialLaw: tangential::no_history::LiggghtsNoHistory, tangential::history::LiggghtsHistory, tangential::paper::PaperCundallStrack,
+        tangential::gran::LammpsGranNoHistory, tangential::gran::LammpsGranHistory, tangential::granular::LammpsLinearNoHistory,
+        tangential::granular::LammpsGranularHistory;
+    CohesionLaw: NoCohesion, cohesion::sjkr::LiggghtsSjkr, cohesion::sjkr2::LiggghtsSjkr2, cohesion::vdw::Hamaker;
+    RollingLaw: NoRolling, rolling::cdt::LiggghtsCdt, rolling::epsd::LiggghtsEpsd, rolling::epsd2::LiggghtsEpsd2, rolling::epsd3::LiggghtsEpsd3,
+        rolling::paper::PaperEpsd, rolling::sds::LammpsSds, rolling::marshall::LammpsTwistMarshall, rolling::marshall::LammpsSdsMarshall;
+}
+
+#[cfg(test)]
+mod tests {
+    /// Every law implemented under `src/physics` is in [`check_flip`]'s list.
+    #[test]
+    fn flip_check_lists_every_law() {
+        fn walk(dir: &std::path::Path, found: &mut Vec<String>) {
+            for e in std::fs::read_dir(dir).unwrap() {
+                let path = e.unwrap().path();
+                if path.is_dir() {
+                    walk(&path, found);
+                } else if path.extension().is_some_and(|x| x == "rs") {
+                    for line in std::fs::read_to_string(&path).unwrap().lines() {
+                        let words: Vec<&str> = line.split_whitespace().collect();
+                        if let ["impl", law, "for", ty, ..] = words[..] {
+                            if ["NormalLaw", "TangentialLaw", "CohesionLaw", "RollingLaw"].contains(&law) {
+                                found.push(format!("{}: {ty}", path.display()));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut found = vec![];
+        walk(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/physics"), &mut found);
+        assert!(found.len() >= 30, "{found:?}");
+        for f in &found {
+            let ty = f.rsplit(' ').next().unwrap();
+            assert!(super::CHECKED_LAWS.iter().any(|c| c.rsplit("::").next().unwrap().replace(' ', "") == ty), "{f} is not in check_flip!");
+        }
+    }
+}

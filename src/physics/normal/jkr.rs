@@ -107,6 +107,9 @@ pub struct LammpsJkr {
 
 impl NormalLaw for LammpsJkr {
     const HISTORY: usize = 1;
+    /// The flag "the surfaces have touched" is the pair's, the same from both
+    /// sides: +1.
+    const FLIP: &'static [f64] = &[1.0];
     const CONTACT_ONLY: bool = false;
     #[inline(always)]
     fn active(&self, c: &Contact, p: &PairParams, hist: &[f64]) -> bool {

@@ -33,6 +33,9 @@ pub struct PaperViscoelastic;
 
 impl NormalLaw for PaperViscoelastic {
     const HISTORY: usize = 1;
+    /// A_n, a coefficient of the pair (from m* and R*, symmetric in i and
+    /// j), is the same from both sides: +1.
+    const FLIP: &'static [f64] = &[1.0];
     const LANES: bool = true;
     #[inline(always)]
     fn normal(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {

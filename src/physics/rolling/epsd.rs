@@ -17,6 +17,10 @@ pub struct LiggghtsEpsd {
 
 impl RollingLaw for LiggghtsEpsd {
     const HISTORY: usize = 3;
+    /// The spring torque sums k_r w dt with w = w_i - w_j (its rolling part
+    /// w - (w . n) n, or all of it with torsionTorque), which turns with the
+    /// pair: -1 each.
+    const FLIP: &'static [f64] = &[-1.0, -1.0, -1.0];
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (w, r) = liggghts_rotation(c);

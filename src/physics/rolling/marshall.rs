@@ -58,6 +58,9 @@ pub struct LammpsTwistMarshall;
 
 impl RollingLaw for LammpsTwistMarshall {
     const HISTORY: usize = 1;
+    /// The twist angle sums (w_i - w_j) . n dt, a product of two factors
+    /// that both flip with the pair: +1 (the torque M n still turns, through n).
+    const FLIP: &'static [f64] = &[1.0];
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         twist(c, p, &mut hist[0], out);
@@ -72,6 +75,18 @@ pub struct LammpsSdsMarshall;
 
 impl RollingLaw for LammpsSdsMarshall {
     const HISTORY: usize = <LammpsSds as RollingLaw>::HISTORY + 1;
+    /// [`LammpsSds`]'s factors for its slots, then the twist angle's (+1, as
+    /// in [`LammpsTwistMarshall`]).
+    const FLIP: &'static [f64] = &{
+        let sds = <LammpsSds as RollingLaw>::FLIP;
+        let mut f = [1.0; <LammpsSds as RollingLaw>::HISTORY + 1];
+        let mut k = 0;
+        while k < sds.len() {
+            f[k] = sds[k];
+            k += 1;
+        }
+        f
+    };
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let (hr, ht) = hist.split_at_mut(<LammpsSds as RollingLaw>::HISTORY);

@@ -26,6 +26,10 @@ pub struct PaperEpsd {
 
 impl RollingLaw for PaperEpsd {
     const HISTORY: usize = 3;
+    /// The spring torque sums k_r w dt with w = w_i - w_j (its rolling part
+    /// w - (w . n) n, or all of it with torsionTorque), which turns with the
+    /// pair: -1 each.
+    const FLIP: &'static [f64] = &[-1.0, -1.0, -1.0];
     const LANES: bool = true;
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {

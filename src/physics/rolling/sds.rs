@@ -26,6 +26,11 @@ pub struct LammpsSds {
 
 impl RollingLaw for LammpsSds {
     const HISTORY: usize = 4;
+    /// The rolling displacement sums v_roll dt, v_roll = R* (w_i - w_j) x n,
+    /// a product of two factors that both flip with the pair: +1 each (the
+    /// torque R* n x F_r still turns, through n). The twist angle sums
+    /// (w_i - w_j) . n dt, also a product of two flipping factors: +1.
+    const FLIP: &'static [f64] = &[1.0, 1.0, 1.0, 1.0];
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let relrot = if c.is_wall() { c.wi } else { c.wi - c.wj };

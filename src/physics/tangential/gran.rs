@@ -27,6 +27,10 @@ fn rj_lever(c: &Contact) -> f64 {
 
 impl TangentialLaw for LammpsGranHistory {
     const HISTORY: usize = 3;
+    /// The shear displacement xi sums v_t dt, v_t the relative tangential
+    /// velocity of the contact points, which turns with the pair (v_i - v_j
+    /// and n flip, (R_i w_i + R_j w_j) x n flips with n): -1 each.
+    const FLIP: &'static [f64] = &[-1.0, -1.0, -1.0];
     const LANES: bool = true;
     #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {

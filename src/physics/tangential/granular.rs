@@ -75,6 +75,11 @@ pub struct LammpsGranularHistory {
 
 impl TangentialLaw for LammpsGranularHistory {
     const HISTORY: usize = 4;
+    /// xi (a displacement summing v_t dt, or an elastic force summing
+    /// -k_t v_t dt) turns with v_t, the relative tangential velocity of the
+    /// contact points (v_i - v_j and n flip): -1 each; the previous contact
+    /// radius a, a magnitude, is the same from both sides: +1.
+    const FLIP: &'static [f64] = &[-1.0, -1.0, -1.0, 1.0];
     #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
         let m = self.model;

@@ -18,6 +18,10 @@ pub struct LiggghtsHistory;
 
 impl TangentialLaw for LiggghtsHistory {
     const HISTORY: usize = 3;
+    /// The shear displacement xi sums v_t dt, v_t the relative tangential
+    /// velocity of the contact points, which turns with the pair (v_i - v_j
+    /// and n flip, (l_i w_i + l_j w_j) x n flips with n): -1 each.
+    const FLIP: &'static [f64] = &[-1.0, -1.0, -1.0];
     const LANES: bool = true;
     #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {

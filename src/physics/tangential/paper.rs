@@ -26,6 +26,10 @@ pub struct PaperCundallStrack;
 
 impl TangentialLaw for PaperCundallStrack {
     const HISTORY: usize = 3;
+    /// The spring force is built from v_t, the relative tangential velocity of
+    /// the contact points, which turns with the pair (v_i - v_j and n flip,
+    /// the spin part (l_i w_i + l_j w_j) x n flips with n): -1 each.
+    const FLIP: &'static [f64] = &[-1.0, -1.0, -1.0];
     const LANES: bool = true;
     #[inline(always)]
     fn tangential(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
