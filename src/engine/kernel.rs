@@ -317,9 +317,11 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         Self::WIDTH
     }
     fn history_signs(&self) -> Vec<f64> {
-        let mut s = [N::FLIP, C::FLIP, T::FLIP, R::FLIP].concat();
-        s.resize(Self::WIDTH, 1.0); // TODO interim until every law states FLIP
-        s
+        // each law's FLIP has one factor per history value (checked when
+        // the crate compiles, physics::check_flip)
+        let signs = [N::FLIP, C::FLIP, T::FLIP, R::FLIP].concat();
+        debug_assert_eq!(signs.len(), Self::WIDTH, "a law's FLIP does not match its HISTORY");
+        signs
     }
     fn noncontact(&self) -> bool {
         C::NONCONTACT
@@ -537,12 +539,15 @@ fn fused_blocks<'a>(
     let virial: Vec<AtomicU64> = (0..nb).map(|_| AtomicU64::new(0)).collect();
     let jobs: Vec<Mutex<Option<Job<'a>>>> = jobs.into_iter().map(|j| Mutex::new(Some(j))).collect();
     let next = AtomicUsize::new(0);
+    // tests take the passes last block first: any order is valid
+    let reversed = REVERSED_PASSES.is_on();
     let take = |q: usize| jobs[q].lock().unwrap_or_else(PoisonError::into_inner).take();
     let work = || loop {
         let q = next.fetch_add(1, Ordering::Relaxed);
         if q >= nb {
             break;
         }
+        let q = if reversed { nb - 1 - q } else { q };
         let Some(mut job) = take(q) else { unreachable!("block {q} passed twice") };
         virial[q].store(pass(&mut job).to_bits(), Ordering::Relaxed);
         *jobs[q].lock().unwrap_or_else(PoisonError::into_inner) = Some(job);
@@ -613,6 +618,13 @@ super::switch::switch!(
     /// would run on lanes (pairs and walls), to check that both give the
     /// same bits.
     SCALAR_ONLY
+);
+
+super::switch::switch!(
+    /// Tests switch it on to run a fused pass's blocks last first, where a
+    /// block that finished as soon as its own pass did would miss the
+    /// shares of the earlier blocks' pairs.
+    REVERSED_PASSES
 );
 
 /// Run `f` with the laws on lanes switched off on this thread (tests).
@@ -920,9 +932,9 @@ mod tests {
         table.get_mut(1, 1).kn = 100.0;
         let laws = Laws { normal: Spring, tangential: Frictionless, cohesion: NoCohesion, rolling: NoRolling };
         // blocks of 64 particles: 7 blocks, many pairs across blocks
-        let run_as = |threads: usize, block: usize, fused: bool| {
+        let run_as = |threads: usize, block: usize, fused: bool, reversed: bool| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| {
+            let go = || {
                 let mut pl = PairList { block, ..Default::default() };
                 pl.build(&p, &dom, &NeighSettings { skin: 0.05, ..Default::default() }, 0, &laws.history_signs(), |_, _| 0.0);
                 // pairs by storage index reach only later blocks
@@ -933,18 +945,22 @@ mod tests {
                 let w = pass_and_gather(&laws, &p, &mut pl, &table, &mut f, &mut t, &mut defer, fused);
                 assert!(block >= p.len() || !pl.cross.is_empty());
                 (f, pl.hist.clone(), w)
-            })
+            };
+            pool.install(|| if reversed { REVERSED_PASSES.on_during(go) } else { go() })
         };
-        let run = |threads: usize, block: usize| run_as(threads, block, false);
+        let run = |threads: usize, block: usize| run_as(threads, block, false, false);
         let (f1, h1, w1) = run(1, 64);
         let (f2, h2, w2) = run(2, 64);
         assert_eq!(f1, f2);
         assert_eq!(h1, h2);
         // each block finished right after the passes that touch it: the
-        // same bits on one and two threads
+        // same bits on one and two threads, and with the passes taken last
+        // block first
         for threads in [1, 2] {
-            let (ff, hf, wf) = run_as(threads, 64, true);
+            let (ff, hf, wf) = run_as(threads, 64, true, false);
             assert_eq!((&ff, &hf, wf.to_bits()), (&f1, &h1, w1.to_bits()), "fused on {threads} threads");
+            let (ff, hf, wf) = run_as(threads, 64, true, true);
+            assert_eq!((&ff, &hf, wf.to_bits()), (&f1, &h1, w1.to_bits()), "fused, last block first, on {threads} threads");
         }
         assert_eq!(w1.to_bits(), w2.to_bits());
         // one block (no cross pairs) gives the same forces up to rounding
