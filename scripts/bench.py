@@ -92,13 +92,18 @@ def prepare_bed():
     return bed
 
 
+def tiles(quick):
+    """The scaling beds' tilings (x, y) of the 7,500-sphere bed: 7,500 and
+    15,000 on either side of the performance issue's 10^4, up to 1,080,000."""
+    return [(1, 1), (2, 2)] if quick else [(1, 1), (2, 1), (2, 2), (4, 4), (8, 8), (12, 12)]
+
+
 def prepare(quick):
     bed = prepare_bed()
-    tiles = [1, 2] if quick else [1, 2, 4, 8, 12]
-    for k in tiles:
-        out = os.path.join(WORK, f"bed{k}x{k}.data")
+    for nx, ny in tiles(quick):
+        out = os.path.join(WORK, f"bed{nx}x{ny}.data")
         if not os.path.exists(out):
-            tile_data(bed, out, k, k)
+            tile_data(bed, out, nx, ny)
     chute = os.path.join(WORK, "data.chute")
     if not os.path.exists(chute):
         print("preparing data.chute (LAMMPS settles the generated lattice, about a minute)", flush=True)
@@ -233,10 +238,10 @@ def main():
                          dict(nsteps=11000 if a.quick else 20000), 1 if a.quick else min(3, a.reps), cwd=mg))
     scaling = []
     if "e" in only:
-        for k in ([1, 2] if a.quick else [1, 2, 4, 8, 12]):
-            n = 7500 * k * k
+        for nx, ny in tiles(a.quick):
+            n = 7500 * nx * ny
             nsteps = max(20 if a.quick else 100, int((2e5 if a.quick else 2e7) / n))
-            r = case(f"(e) bed {n:,} spheres", bench("in.bed.liggghts"), None, dict(data=f"bed{k}x{k}.data", nsteps=nsteps),
+            r = case(f"(e) bed {n:,} spheres", bench("in.bed.liggghts"), None, dict(data=f"bed{nx}x{ny}.data", nsteps=nsteps),
                      1 if a.quick else min(3, a.reps))
             r["n"], r["steps"] = n, nsteps
             scaling.append(r)
@@ -285,6 +290,13 @@ def write(a, rows, scaling):
         for r in scaling:
             lines.append(f"| {r['n']:,} | {r['steps']} | {r['demx']:.3e} | {r['demx'] / base:.2f} | {r['drss'] / 1024:.0f} | "
                          f"{r['drss'] * 1024 / r['n']:.0f} |")
+        # the issue's range: 10^4 to 10^6 particles (1,080,000 counted as 10^6)
+        within = [r for r in scaling if 1e4 <= r["n"] <= 1.1e6]
+        if len(within) > 1:
+            lo, hi = min(within, key=lambda r: r["demx"]), max(within, key=lambda r: r["demx"])
+            lines += ["", f"From {within[0]['n']:,} to {within[-1]['n']:,} particles (the issue's 10^4 to 10^6): the slowest "
+                          f"({lo['n']:,}, {lo['demx']:.3e}) is {100 * (1 - lo['demx'] / hi['demx']):.0f}% below the fastest "
+                          f"({hi['n']:,}, {hi['demx']:.3e})."]
     lines += ["", PROFILE_END]
     block = "\n".join(lines)
     old = open(a.out).read() if os.path.exists(a.out) else "# Benchmarks\n"

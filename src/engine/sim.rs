@@ -324,7 +324,9 @@ impl Sim {
     /// ([`Sim::fused_pass`]).
     fn fusable(&self) -> bool {
         let n = self.particles.len();
-        self.model.is_some() && n > 0 && self.pairs.forward && self.pairs.indexed(n) && self.pairs.block_deps.len() == n.div_ceil(self.pairs.block_size()) && !UNFUSED.is_on()
+        // one block gains nothing: its tail follows its pass either way
+        let blocks = n.div_ceil(self.pairs.block_size());
+        self.model.is_some() && blocks > 1 && self.pairs.forward && self.pairs.indexed(n) && self.pairs.block_deps.len() == blocks && !UNFUSED.is_on()
     }
 
     /// The step's pair pass fused with the tail that follows it (the cross
