@@ -389,7 +389,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         let nblocks = block_start.len().saturating_sub(1);
         let mut jobs = Vec::with_capacity(nblocks);
         // the deferred slots as the cross pass of a fused tail reads them
-        let slots = Shared(defer.as_mut_ptr() as *const [V3; 2]);
+        let slots = Shared(defer.as_mut_ptr());
         let (mut hrest, mut drest, mut lrest) = (hist, &mut defer[..], live);
         let (mut frest, mut trest) = (&mut force.f[..n], &mut force.torque[..n]);
         for q in 0..nblocks {
@@ -500,16 +500,19 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
 /// slots and live flags, and its particles' forces and torques.
 type Job<'a> = (usize, &'a mut [f64], &'a mut [[V3; 2]], &'a mut [u8], &'a mut [V3], &'a mut [V3]);
 
-/// A pointer the fused blocks share across threads (see [`fused_blocks`]).
+/// A pointer the blocks of a fused pass share across threads: the deferred
+/// slots here, the particles' state in `Sim::fused_pass`.
 #[derive(Clone, Copy)]
-struct Shared<T>(*const T);
-// SAFETY: only read through, at times the dependency counts of
-// `fused_blocks` order after every write to what is read
+pub(crate) struct Shared<T>(pub(crate) *mut T);
+// SAFETY: what is read or written through it is ordered by the dependency
+// counts of `fused_blocks`: a block's entries are written by one finish at
+// a time, after every pass that reads them, and read by a finish only after
+// every pass that wrote them
 unsafe impl<T> Sync for Shared<T> {}
 unsafe impl<T> Send for Shared<T> {}
 
 impl<T> Shared<T> {
-    fn ptr(self) -> *const T {
+    pub(crate) fn ptr(self) -> *mut T {
         self.0
     }
 }

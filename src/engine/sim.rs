@@ -3,7 +3,7 @@
 use super::compute::Compute;
 use super::domain::Domain;
 use super::fix::{Chunk, Fix, Hole, Hook, Local, Stage};
-use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable, PassState};
+use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable, PassState, Shared};
 use super::neighbor::{Due, NeighSettings, PairList, Travel};
 use super::output::{Dump, Logger, Thermo};
 use super::particles::Particles;
@@ -27,21 +27,6 @@ super::switch::switch!(
 /// Run `f` with the step's head and tail unfused on this thread (tests).
 pub fn with_unfused_tail<T>(f: impl FnOnce() -> T) -> T {
     UNFUSED.on_during(f)
-}
-
-/// A pointer the fused pass's blocks share across threads
-/// ([`Sim::fused_pass`]).
-#[derive(Clone, Copy)]
-struct Raw<T>(*mut T);
-// SAFETY: each block's entries are written by one finish at a time, after
-// every read of them by a pass (see `Sim::fused_pass`)
-unsafe impl<T> Sync for Raw<T> {}
-unsafe impl<T> Send for Raw<T> {}
-
-impl<T> Raw<T> {
-    fn ptr(self) -> *mut T {
-        self.0
-    }
 }
 
 /// Which engine's conventions a deck follows.
@@ -349,8 +334,8 @@ impl Sim {
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, frozen, .. } = &mut self.particles;
         let n = x.len();
         let (mut fv, mut tv) = (std::mem::take(f), std::mem::take(torque));
-        let (xp, vp, wp) = (Raw(x.as_mut_ptr()), Raw(v.as_mut_ptr()), Raw(omega.as_mut_ptr()));
-        let cols: Vec<(Raw<f64>, usize)> = extra.iter_mut().map(|e| (Raw(e.data.as_mut_ptr()), e.width)).collect();
+        let (xp, vp, wp) = (Shared(x.as_mut_ptr()), Shared(v.as_mut_ptr()), Shared(omega.as_mut_ptr()));
+        let cols: Vec<(Shared<f64>, usize)> = extra.iter_mut().map(|e| (Shared(e.data.as_mut_ptr()), e.width)).collect();
         let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
         // SAFETY: while the pass runs, positions, velocities and angular
         // velocities are read through these and written only by `tail`,
