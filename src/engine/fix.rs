@@ -104,7 +104,9 @@ pub trait Fix: Send {
     /// particle (a [`Stage`], run fused with its neighbours instead of the
     /// hook), or on the whole simulation (the hook is called). Called in the
     /// hooks' order, but before earlier fixes' stages have run, so a stage
-    /// must not depend on what they change. The default calls the hook.
+    /// must not depend on what they change; and for the tail's hooks before
+    /// the step's pair forces are computed (a stage's `apply` sees them,
+    /// this call must not read them). The default calls the hook.
     fn local(&mut self, _hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
         Ok(Local::Whole)
     }
