@@ -478,7 +478,6 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         let pass = |job: &mut Job<'_>| if lanes { batched(job) } else { block(job) };
         let virials: Vec<f64> = match tail {
             Some(tail) => {
-                let ncross = ncross;
                 fused_blocks(pairs, jobs, &pass, &|s: usize, f: &mut [V3], tq: &mut [V3]| {
                     // SAFETY: the slots block `s` reads were written by
                     // passes that are over (its dependency count reached
@@ -532,7 +531,7 @@ fn fused_blocks<'a>(
     pairs: &PairList,
     jobs: Vec<Job<'a>>,
     pass: &(dyn Fn(&mut Job<'a>) -> f64 + Sync),
-    finish: &(dyn Fn(usize, &mut [V3], &mut [V3]) + Sync),
+    finish: &Tail<'_>,
 ) -> Vec<f64> {
     use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
     use std::sync::{Mutex, PoisonError};

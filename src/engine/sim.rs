@@ -29,6 +29,19 @@ pub fn with_unfused_tail<T>(f: impl FnOnce() -> T) -> T {
     UNFUSED.on_during(f)
 }
 
+/// The stages of a fused run on one chunk, then its travel when `measure`
+/// ([`PairList::travel`] with `lim`).
+fn finish(mut c: Chunk<'_>, stages: &[Box<dyn Stage>], pairs: &PairList, measure: bool, lim: Option<f64>) -> Travel {
+    for st in stages {
+        st.apply(&mut c);
+    }
+    if measure {
+        pairs.travel(c.x, c.lo, lim)
+    } else {
+        Travel::default()
+    }
+}
+
 /// Which engine's conventions a deck follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum Dialect {
@@ -305,13 +318,21 @@ impl Sim {
         (p.f, p.torque) = (f, torque);
     }
 
+    /// What a fused run measures ([`Sim::fused`]'s `measure`): whether it
+    /// measures the travel at all, and the skin check's limit when it checks
+    /// since the last build.
+    fn measuring(&self, measure: Option<bool>) -> (bool, Option<f64>) {
+        let check = measure == Some(true);
+        (check || (measure.is_some() && self.pairs.pruned()), check.then(|| self.neigh.skin_limit()))
+    }
+
     /// Whether the step's pair pass may run fused with its tail
     /// ([`Sim::fused_pass`]).
     fn fusable(&self) -> bool {
         let n = self.particles.len();
         // one block gains nothing: its tail follows its pass either way
         let blocks = n.div_ceil(self.pairs.block_size());
-        self.model.is_some() && blocks > 1 && self.pairs.forward && self.pairs.indexed(n) && self.pairs.block_deps.len() == blocks && !UNFUSED.is_on()
+        self.model.is_some() && blocks > 1 && self.pairs.forward && self.pairs.indexed(n) && !UNFUSED.is_on()
     }
 
     /// The step's pair pass fused with the tail that follows it (the cross
@@ -326,9 +347,7 @@ impl Sim {
         use std::sync::atomic::{AtomicU64, Ordering};
         use std::sync::{Mutex, PoisonError};
         let start = Instant::now();
-        let check = measure == Some(true);
-        let measure = check || (measure.is_some() && self.pairs.pruned());
-        let lim = check.then(|| self.neigh.skin_limit());
+        let (measure, lim) = self.measuring(measure);
         let (mut hist, mut live) = self.pairs.take_history();
         let Some(m) = &self.model else { unreachable!("fused pass without a pair model") };
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, frozen, .. } = &mut self.particles;
@@ -370,13 +389,8 @@ impl Sim {
                     cols.iter().map(|&(c, w)| std::slice::from_raw_parts_mut(c.ptr().add(lo * w), len * w)).collect(),
                 )
             };
-            let mut c = Chunk { lo, x, radius, mass, kind, mask, v, omega, f, torque, extra };
-            for st in pending {
-                st.apply(&mut c);
-            }
-            if measure {
-                *moved[s].lock().unwrap_or_else(PoisonError::into_inner) = pairs.travel(c.x, lo, lim);
-            }
+            let travel = finish(Chunk { lo, x, radius, mass, kind, mask, v, omega, f, torque, extra }, pending, pairs, measure, lim);
+            *moved[s].lock().unwrap_or_else(PoisonError::into_inner) = travel;
             tail_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         };
         let force = Forces { f: &mut fv, torque: &mut tv, defer: &mut self.pair_defer };
@@ -387,8 +401,7 @@ impl Sim {
         stages.clear();
         // the pass's share of the time: the whole less the finishes' (their
         // time summed over the threads, which ran them side by side)
-        let threads = if nblocks > 1 { rayon::current_num_threads() } else { 1 };
-        let tails = tail_ns.load(Ordering::Relaxed) as f64 * 1e-9 / threads as f64;
+        let tails = tail_ns.load(Ordering::Relaxed) as f64 * 1e-9 / rayon::current_num_threads() as f64;
         self.pass_secs += (start.elapsed().as_secs_f64() - tails).max(0.0);
         // maxima over the blocks: the same on any thread count
         moved.into_iter().map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner)).fold(Travel::default(), Travel::max)
@@ -621,13 +634,11 @@ impl Sim {
             self.pair_pass(self.dt);
             self.pass_secs += t.elapsed().as_secs_f64();
         }
-        let check = measure == Some(true);
-        let measure = check || (measure.is_some() && self.pairs.pruned());
+        let (measure, lim) = self.measuring(measure);
         if stages.is_empty() && !gather && !measure {
             return Travel::default();
         }
         let cross = gather && !self.pairs.cross.is_empty();
-        let lim = check.then(|| self.neigh.skin_limit());
         let (pairs, defer) = (&self.pairs, &self.pair_defer[..]);
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, .. } = &mut self.particles;
         let n = x.len();
@@ -657,18 +668,11 @@ impl Sim {
             })
             .collect();
         let pending = &*stages;
-        let run = |mut c: Chunk<'_>| -> Travel {
+        let run = |c: Chunk<'_>| -> Travel {
             if cross {
                 cross_gather_chunk(pairs, defer, c.lo, c.f, c.torque);
             }
-            for st in pending {
-                st.apply(&mut c);
-            }
-            if measure {
-                pairs.travel(c.x, c.lo, lim)
-            } else {
-                Travel::default()
-            }
+            finish(c, pending, pairs, measure, lim)
         };
         // maxima over the chunks: the same on any thread count
         let moved = if jobs.len() > 1 {
