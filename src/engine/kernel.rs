@@ -655,6 +655,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let mut slot = 0;
         let (lo, len) = (k.lo, f.len());
         let mut queued = 0;
+        // the batches' lanes, cleared once per block: each batch writes
+        // every lane it reads
+        let mut lanes = BatchLanes::new();
         let mut virial = 0.0;
         // non-contact cohesion reaches beyond touching, by the pair's
         // `extra_range` (as in the per-contact pass)
@@ -695,12 +698,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             // are cleared after the walk (rare; a branch here would not be)
             lv[q] = ((lv[q] & 1) << 2) | (!apart) as u8;
             if queued == LANES {
-                self.run_batch(k, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
+                self.run_batch(k, &mut lanes, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
                 queued = 0;
             }
         }
         if queued > 0 {
-            self.run_batch(k, &queue, &slots, queued, h, d, lv, f, tq, &mut virial);
+            self.run_batch(k, &mut lanes, &queue, &slots, queued, h, d, lv, f, tq, &mut virial);
         }
         for (q, l) in lv.iter_mut().enumerate() {
             if *l & (WAS_LIVE | 1) == WAS_LIVE {
@@ -719,6 +722,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     fn run_batch(
         &self,
         k: &Block<'_>,
+        lanes: &mut BatchLanes,
         queue: &[usize; LANES],
         slots: &[usize; LANES],
         count: usize,
@@ -731,13 +735,10 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     ) {
         let p = k.p;
         let w = Self::WIDTH;
-        let z = Vec3::<F8>::zeros();
-        let zf = F8::splat(0.0);
-        let mut s = PairState { xi: z, xj: z, vi: z, vj: z, wi: z, wj: z, ri: zf, rj: zf, mi: zf, mj: zf };
+        let BatchLanes { s, hist } = lanes;
         let one_type = k.table.ntypes == 1;
         let p0 = k.table.get(p.kind[k.a[queue[0]] as usize], p.kind[k.b[queue[0]] as usize]);
         let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
-        let mut hist = [zf; MAX_BATCH_HISTORY];
         let put = |v: &mut Vec3<F8>, l: usize, x: &V3| {
             v.x.0[l] = x.x;
             v.y.0[l] = x.y;
@@ -766,7 +767,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 hist[m].0[l] = *v;
             }
         }
-        let c = contact_lanes(&s, k.dt);
+        let c = contact_lanes(s, k.dt);
         let o = self.apply_lanes(&c, &coeffs, &mut hist[..w]);
         let fi = o.force_i(&c);
         let vir = (s.xi - s.xj).dot(&fi);
@@ -797,6 +798,24 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 d[k.xs[slots[l]] as usize] = [fl, o.torque_j.lane(l)];
             }
         }
+    }
+}
+
+/// The lanes of a batch of the batched pass: the pairs' state and history.
+/// Kept across a block's batches, so that they are cleared once per block,
+/// not per batch (a batch writes every lane of the state and of the
+/// history values the laws read).
+struct BatchLanes {
+    s: PairState<F8>,
+    hist: [F8; MAX_BATCH_HISTORY],
+}
+
+impl BatchLanes {
+    #[inline(always)]
+    fn new() -> BatchLanes {
+        let z = Vec3::<F8>::zeros();
+        let zf = F8::splat(0.0);
+        BatchLanes { s: PairState { xi: z, xj: z, vi: z, vj: z, wi: z, wj: z, ri: zf, rj: zf, mi: zf, mj: zf }, hist: [zf; MAX_BATCH_HISTORY] }
     }
 }
 
