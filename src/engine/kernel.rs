@@ -851,18 +851,19 @@ pub fn cross_gather_chunk(pairs: &PairList, defer: &[[V3; 2]], lo: usize, f: &mu
     // each read in order (`PairList::xslot`) but jumping from range to
     // range: prefetch a few ahead, as the pair walk does (measured: fewer
     // samples here with it, on beds of 1.2e5 and 1.1e6 spheres)
-    let last = (pairs.cross_start[lo + f.len()] as usize).saturating_sub(1);
-    for q in 0..f.len() {
-        let i = lo + q;
-        let (s, e) = (pairs.cross_start[i] as usize, pairs.cross_start[i + 1] as usize);
-        // apart pairs add zeros, which leave every bit as it is: the
-        // sums started from +0.0, so they are never -0.0
-        for (c, &slot) in pairs.cross[s..e].iter().enumerate() {
-            prefetch(defer, pairs.cross[(s + c + PREFETCH_AHEAD).min(last)] as usize);
-            let o = &defer[slot as usize];
-            f[q] -= o[0];
-            torque[q] += o[1];
-        }
+    let (s, e) = (pairs.cross_start[lo] as usize, pairs.cross_start[lo + f.len()] as usize);
+    let last = e.saturating_sub(1);
+    // the entries run particle by particle, each particle's in increasing
+    // pair index: the order its shares were always added, without a branch
+    // on whether a particle has any (most have none)
+    for (c, (&slot, &i)) in pairs.cross[s..e].iter().zip(&pairs.cross_b[s..e]).enumerate() {
+        prefetch(defer, pairs.cross[(s + c + PREFETCH_AHEAD).min(last)] as usize);
+        let q = i as usize - lo;
+        // apart pairs add zeros, which leave every bit as it is: the sums
+        // started from +0.0, so they are never -0.0
+        let o = &defer[slot as usize];
+        f[q] -= o[0];
+        torque[q] += o[1];
     }
 }
 

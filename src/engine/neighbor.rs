@@ -94,6 +94,9 @@ pub struct PairList {
     /// and `a` lies in another block, in increasing pair index: their share
     /// is added after the block pass.
     pub cross: Vec<u32>,
+    /// The particle of each entry of `cross` (its `b`), so that a block's
+    /// cross pass runs over its entries without a branch per particle.
+    pub cross_b: Vec<u32>,
     /// Slot where each block's cross pairs start (blocks + 1 entries).
     pub block_cross: Vec<u32>,
     /// Per cross pair, in pair order: its slot, counted from its block's
@@ -1023,10 +1026,13 @@ impl PairList {
         let mut fill = ccount.clone();
         self.cross.clear();
         self.cross.resize(self.xslot.len(), 0);
+        self.cross_b.clear();
+        self.cross_b.resize(self.xslot.len(), 0);
         for (q, (ks, place)) in per.iter().enumerate() {
             for (&k, &r) in ks.iter().zip(place) {
                 let i = b[k as usize] as usize;
                 self.cross[fill[i] as usize] = self.block_cross[q] + r;
+                self.cross_b[fill[i] as usize] = i as u32;
                 fill[i] += 1;
             }
         }
