@@ -37,6 +37,19 @@ pub enum Local {
 pub trait Stage: Send + Sync {
     /// Apply to the particles of `c`.
     fn apply(&self, c: &mut Chunk<'_>);
+
+    /// One stage doing this stage and then `next`, particle by particle,
+    /// with the same operations in the same order, where that saves work
+    /// (the integration's two halves share their divisions); `None` where
+    /// the two stay apart.
+    fn then(&self, _next: &dyn Stage) -> Option<Box<dyn Stage>> {
+        None
+    }
+
+    /// The integration's first half, when this stage is one (for [`Stage::then`]).
+    fn initial_half(&self) -> Option<&super::integrate::InitialHalf> {
+        None
+    }
 }
 
 /// The particles `lo..lo + v.len()` of a fused pass: their own entries to

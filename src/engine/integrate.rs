@@ -128,6 +128,10 @@ impl Stage for InitialHalf {
             }
         }
     }
+
+    fn initial_half(&self) -> Option<&InitialHalf> {
+        Some(self)
+    }
 }
 
 /// Second half: v += dt/2 f/m; omega += dt/2 torque/I.
@@ -166,6 +170,51 @@ impl Stage for FinalHalf {
             let i = c.lo + q;
             if c.mask[i] & self.group != 0 {
                 self.one(c.f[q], c.torque[q], c.mass[i], c.radius[i], &mut c.v[q], &mut c.omega[q]);
+            }
+        }
+    }
+
+    /// A step's second half followed by the next step's first, of the same
+    /// fix (group, step, rotation): one pass.
+    fn then(&self, next: &dyn Stage) -> Option<Box<dyn Stage>> {
+        let n = next.initial_half()?;
+        let same = n.group == self.group && n.dt.to_bits() == self.dt.to_bits() && n.rotate == self.rotate;
+        same.then(|| Box::new(Halves { group: self.group, dt: self.dt, rotate: self.rotate }) as Box<dyn Stage>)
+    }
+}
+
+/// [`FinalHalf`] and then [`InitialHalf`] of one fix, particle by
+/// particle: v += dt/2 f/m; omega += dt/2 torque/I; then v += dt/2 f/m;
+/// x += dt v; omega += dt/2 torque/I (LAMMPS `FixNVESphere`). The same
+/// operations as the two stages one after the other, so the same bits;
+/// each particle's dt/2m and dt/2I are divided out once, not twice, and its
+/// state is read once.
+struct Halves {
+    group: u32,
+    dt: f64,
+    rotate: bool,
+}
+
+impl Stage for Halves {
+    fn apply(&self, c: &mut Chunk<'_>) {
+        let dt = self.dt;
+        let dtf = 0.5 * dt;
+        for q in 0..c.v.len() {
+            let i = c.lo + q;
+            if c.mask[i] & self.group != 0 {
+                let (m, r, f) = (c.mass[i], c.radius[i], c.f[q]);
+                let dtfm = dtf / m;
+                let v = &mut c.v[q];
+                *v += f * dtfm;
+                *v += f * dtfm;
+                c.x[q] += *v * dt;
+                if self.rotate {
+                    let dtirotate = dtf / INERTIA / (r * r * m);
+                    let t = c.torque[q];
+                    let w = &mut c.omega[q];
+                    *w += t * dtirotate;
+                    *w += t * dtirotate;
+                }
             }
         }
     }
@@ -222,6 +271,71 @@ mod tests {
             z
         );
         assert!((p.v[0].z - (2.0 - g * t)).abs() < 1e-9);
+    }
+
+    /// The fused tail's one pass of a step's second half and the next
+    /// step's first gives the bits of the two stages in turn, with and
+    /// without rotation, and leaves particles outside the group alone; two
+    /// halves of different fixes (group, step, rotation) stay apart.
+    #[test]
+    fn merged_halves_are_the_two_stages_bit_for_bit() {
+        let n = 101;
+        let make = || {
+            let mut p = Particles::default();
+            for k in 0..n {
+                let s = (k as f64 * 0.618).fract();
+                p.push(NewParticle {
+                    tag: k as i64 + 1,
+                    kind: 1,
+                    mask: if k % 7 == 0 { 1 } else { 2 },
+                    x: V3::new(s, 1.0 - s, 2.0 * s),
+                    v: V3::new(0.1 * s, -0.2, 0.3 * s),
+                    omega: V3::new(1.0, s, -s),
+                    radius: 1e-3 * (1.0 + s),
+                    density: 2500.0 + 100.0 * s,
+                });
+                p.f[k] = V3::new(s - 0.5, 0.25 * s, -1.0 / 3.0);
+                p.torque[k] = V3::new(1e-6 * s, -1e-6 / 3.0, 2e-6 * s);
+            }
+            p
+        };
+        let run = |p: &mut Particles, stages: &[&dyn Stage]| {
+            let (radius, mass, kind, mask) = (p.radius.clone(), p.mass.clone(), p.kind.clone(), p.mask.clone());
+            let mut c = Chunk {
+                lo: 0,
+                x: &mut p.x,
+                radius: &radius,
+                mass: &mass,
+                kind: &kind,
+                mask: &mask,
+                v: &mut p.v,
+                omega: &mut p.omega,
+                f: &mut p.f,
+                torque: &mut p.torque,
+                extra: vec![],
+            };
+            for s in stages {
+                s.apply(&mut c);
+            }
+        };
+        let bits = |p: &Particles| p.x.iter().chain(&p.v).chain(&p.omega).flat_map(|v| [v.x, v.y, v.z]).map(f64::to_bits).collect::<Vec<_>>();
+        let dt = 1e-5 / 3.0;
+        for rotate in [true, false] {
+            let (fin, ini) = (FinalHalf { group: 2, dt, rotate }, InitialHalf { group: 2, dt, rotate });
+            let both = fin.then(&ini).expect("halves of one fix merge");
+            let (mut a, mut b) = (make(), make());
+            run(&mut a, &[&fin, &ini]);
+            run(&mut b, &[&*both]);
+            assert_eq!(bits(&a), bits(&b), "rotate {rotate}");
+            let c = make();
+            assert_ne!(bits(&a), bits(&c), "the stages moved the particles");
+            assert_eq!(bits(&a)[0..3], bits(&c)[0..3], "particle 0 is outside the group");
+        }
+        let fin = FinalHalf { group: 2, dt, rotate: true };
+        for other in [InitialHalf { group: 1, dt, rotate: true }, InitialHalf { group: 2, dt: 2.0 * dt, rotate: true }, InitialHalf { group: 2, dt, rotate: false }] {
+            assert!(fin.then(&other).is_none());
+        }
+        assert!(InitialHalf { group: 2, dt, rotate: true }.then(&fin).is_none(), "only second half, then first");
     }
 
     /// Several chunks (the parallel path): every particle gets the update of

@@ -611,7 +611,10 @@ impl Sim {
                 };
                 self.fixes[k] = fix;
                 if let Local::Stage(st) = local? {
-                    stages.push(st);
+                    match stages.last().and_then(|last| last.then(&*st)) {
+                        Some(both) => *stages.last_mut().expect("a last stage") = both,
+                        None => stages.push(st),
+                    }
                 }
             }
         }
