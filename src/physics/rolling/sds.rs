@@ -30,6 +30,12 @@ impl RollingLaw for LammpsSds {
     /// a product of two factors that both flip with the pair: +1 each (the
     /// torque R* n x F_r still turns, through n). The twist angle sums
     /// (w_i - w_j) . n dt, also a product of two flipping factors: +1.
+    /// Debian's LAMMPS (29 Sep 2021) transfers these with its default
+    /// factor, -1 (`PairGranular::transfer_history`; a later source of its
+    /// granular sub-models gives the SDS rolling history +1, for the same
+    /// reason as here), so there a contact's rolling
+    /// displacement changes sign when its pair changes order (an atom sort,
+    /// a migration); demx does not follow that.
     const FLIP: &'static [f64] = &[1.0, 1.0, 1.0, 1.0];
     #[inline(always)]
     fn rolling(&self, c: &Contact, p: &PairParams, hist: &mut [f64], out: &mut ContactOut) {
