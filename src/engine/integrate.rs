@@ -273,32 +273,35 @@ mod tests {
         assert!((p.v[0].z - (2.0 - g * t)).abs() < 1e-9);
     }
 
+    /// `n` particles with spread-out state, forces and torques, and the
+    /// group bits `mask(k)`.
+    fn spread(n: usize, mask: impl Fn(usize) -> u32) -> Particles {
+        let mut p = Particles::default();
+        for k in 0..n {
+            let s = (k as f64 * 0.618).fract();
+            p.push(NewParticle {
+                tag: k as i64 + 1,
+                kind: 1,
+                mask: mask(k),
+                x: V3::new(s, 1.0 - s, 2.0 * s),
+                v: V3::new(0.1 * s, -0.2, 0.3 * s),
+                omega: V3::new(1.0, s, -s),
+                radius: 1e-3 * (1.0 + s),
+                density: 2500.0 + 100.0 * s,
+            });
+            p.f[k] = V3::new(s - 0.5, 0.25 * s, -1.0 / 3.0);
+            p.torque[k] = V3::new(1e-6 * s, -1e-6 / 3.0, 2e-6 * s);
+        }
+        p
+    }
+
     /// The fused tail's one pass of a step's second half and the next
     /// step's first gives the bits of the two stages in turn, with and
     /// without rotation, and leaves particles outside the group alone; two
     /// halves of different fixes (group, step, rotation) stay apart.
     #[test]
     fn merged_halves_are_the_two_stages_bit_for_bit() {
-        let n = 101;
-        let make = || {
-            let mut p = Particles::default();
-            for k in 0..n {
-                let s = (k as f64 * 0.618).fract();
-                p.push(NewParticle {
-                    tag: k as i64 + 1,
-                    kind: 1,
-                    mask: if k % 7 == 0 { 1 } else { 2 },
-                    x: V3::new(s, 1.0 - s, 2.0 * s),
-                    v: V3::new(0.1 * s, -0.2, 0.3 * s),
-                    omega: V3::new(1.0, s, -s),
-                    radius: 1e-3 * (1.0 + s),
-                    density: 2500.0 + 100.0 * s,
-                });
-                p.f[k] = V3::new(s - 0.5, 0.25 * s, -1.0 / 3.0);
-                p.torque[k] = V3::new(1e-6 * s, -1e-6 / 3.0, 2e-6 * s);
-            }
-            p
-        };
+        let make = || spread(101, |k| if k % 7 == 0 { 1 } else { 2 });
         let run = |p: &mut Particles, stages: &[&dyn Stage]| {
             let (radius, mass, kind, mask) = (p.radius.clone(), p.mass.clone(), p.kind.clone(), p.mask.clone());
             let mut c = Chunk {
@@ -344,25 +347,7 @@ mod tests {
     #[test]
     fn chunked_update_is_the_formula_on_any_thread_count() {
         let n = 3 * CHUNK + 17;
-        let make = || {
-            let mut p = Particles::default();
-            for k in 0..n {
-                let s = (k as f64 * 0.618).fract();
-                p.push(NewParticle {
-                    tag: k as i64 + 1,
-                    kind: 1,
-                    mask: if k % 5 == 0 { 2 } else { 1 },
-                    x: V3::new(s, 1.0 - s, 2.0 * s),
-                    v: V3::new(0.1 * s, -0.2, 0.3 * s),
-                    omega: V3::new(1.0, s, -s),
-                    radius: 1e-3 * (1.0 + s),
-                    density: 2500.0,
-                });
-                p.f[k] = V3::new(s - 0.5, 0.25 * s, -1.0);
-                p.torque[k] = V3::new(1e-6 * s, -1e-6, 2e-6 * s);
-            }
-            p
-        };
+        let make = || spread(n, |k| if k % 5 == 0 { 2 } else { 1 });
         let dt = 1e-5;
         let run = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
