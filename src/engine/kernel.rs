@@ -464,6 +464,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             }
             virial
         };
+        // read here: the blocks may run on other threads
+        let dense_only = DENSE_ONLY.is_on();
         let batched = |(q, h, d, lv, f, tq): &mut Job<'_>| -> f64 {
             let (q, h, d, lv, f, tq) = (*q, &mut **h, &mut **d, &mut **lv, &mut **f, &mut **tq);
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
@@ -471,7 +473,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             f.fill(V3::zeros());
             tq.fill(V3::zeros());
             let xs = &xslot[block_cross[q] as usize..];
-            let blk = Block { p, a, b, image, images, xs, table, dt, lo: q * bs, ps, pe };
+            let blk = Block { p, a, b, image, images, xs, table, dt, lo: q * bs, ps, pe, dense: dense_only };
             self.block_batched(&blk, h, d, lv, f, tq)
         };
         let lanes = Self::BATCHED && !self.scalar_only();
@@ -613,6 +615,8 @@ struct Block<'a> {
     /// The block's pairs.
     ps: usize,
     pe: usize,
+    /// Run it in batches of consecutive pairs however few touch (tests).
+    dense: bool,
 }
 
 super::switch::switch!(
@@ -620,6 +624,13 @@ super::switch::switch!(
     /// would run on lanes (pairs and walls), to check that both give the
     /// same bits.
     SCALAR_ONLY
+);
+
+super::switch::switch!(
+    /// Tests switch it on to run every block of the batched pass in
+    /// batches of consecutive pairs (as a block whose pairs mostly touch),
+    /// to check that both forms give the same bits.
+    DENSE_ONLY
 );
 
 super::switch::switch!(
@@ -646,6 +657,66 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// lanes' forces in queue order.
     #[inline(always)]
     fn block_batched(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
+        // most pairs touched at the last pass (a bed at rest): batches of
+        // consecutive pairs, without a walk that sorts them out first
+        let live = lv.iter().map(|&l| (l & 1) as usize).sum::<usize>();
+        let virial = if (3 * live >= 2 * lv.len() && lv.len() >= LANES) || (k.dense && !lv.is_empty()) {
+            self.block_dense(k, h, d, lv, f, tq)
+        } else {
+            self.block_walk(k, h, d, lv, f, tq)
+        };
+        let w = Self::WIDTH;
+        for (q, l) in lv.iter_mut().enumerate() {
+            if *l & (WAS_LIVE | 1) == WAS_LIVE {
+                h[q * w..(q + 1) * w].fill(0.0);
+            }
+            *l &= !WAS_LIVE;
+        }
+        virial
+    }
+
+    /// A block's pairs in batches of [`LANES`] consecutive ones, touching
+    /// or not: each batch decides which of its lanes touch by the walk's
+    /// test, on lanes, and adds the forces of those alone, in pair order:
+    /// the same contributions in the same order as [`Self::block_walk`].
+    #[inline(always)]
+    fn block_dense(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
+        let p = k.p;
+        let w = Self::WIDTH;
+        let (lo, len) = (k.lo, f.len());
+        let mut queue = [0usize; LANES];
+        let mut slots = [0usize; LANES];
+        let mut slot = 0;
+        let mut lanes = BatchLanes::new();
+        let mut virial = 0.0;
+        let n = k.pe - k.ps;
+        let last = k.pe.saturating_sub(1);
+        let mut q0 = 0;
+        while q0 < n {
+            let count = (n - q0).min(LANES);
+            for l in 0..count {
+                let q = q0 + l;
+                let ahead = k.b[(k.ps + q + PREFETCH_AHEAD).min(last)] as usize;
+                prefetch(&p.x, ahead);
+                prefetch(&p.v, ahead);
+                prefetch(&p.omega, ahead);
+                prefetch(&p.radius, ahead);
+                prefetch(&p.mass, ahead);
+                prefetch(h, (q + PREFETCH_AHEAD) * w);
+                queue[l] = k.ps + q;
+                slots[l] = slot;
+                slot += ((k.b[k.ps + q] as usize).wrapping_sub(lo) >= len) as usize;
+            }
+            self.run_batch::<true>(k, &mut lanes, &queue, &slots, count, h, d, lv, f, tq, &mut virial);
+            q0 += count;
+        }
+        virial
+    }
+
+    /// A block's pairs walked one by one: those apart are sorted out, the
+    /// touching ones queued and run in batches.
+    #[inline(always)]
+    fn block_walk(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
         let p = k.p;
         let w = Self::WIDTH;
         let mut queue = [0usize; LANES];
@@ -698,18 +769,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             // are cleared after the walk (rare; a branch here would not be)
             lv[q] = ((lv[q] & 1) << 2) | (!apart) as u8;
             if queued == LANES {
-                self.run_batch(k, &mut lanes, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
+                self.run_batch::<false>(k, &mut lanes, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
                 queued = 0;
             }
         }
         if queued > 0 {
-            self.run_batch(k, &mut lanes, &queue, &slots, queued, h, d, lv, f, tq, &mut virial);
-        }
-        for (q, l) in lv.iter_mut().enumerate() {
-            if *l & (WAS_LIVE | 1) == WAS_LIVE {
-                h[q * w..(q + 1) * w].fill(0.0);
-            }
-            *l &= !WAS_LIVE;
+            self.run_batch::<false>(k, &mut lanes, &queue, &slots, queued, h, d, lv, f, tq, &mut virial);
         }
         virial
     }
@@ -717,9 +782,11 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// Gather `count` queued pairs into lanes (the rest repeat the last one
     /// and are dropped), run the laws, write history back and add forces in
     /// queue order, and the lanes' virial to `virial`, in queue order.
+    /// `DENSE`: the pairs were not sorted out by the walk; the batch sets
+    /// their live flags and keeps the touching lanes alone.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn run_batch(
+    fn run_batch<const DENSE: bool>(
         &self,
         k: &Block<'_>,
         lanes: &mut BatchLanes,
@@ -767,11 +834,31 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 hist[m].0[l] = *v;
             }
         }
+        // which lanes touch, as the walk decides it (the same operations:
+        // r^2 summed x + y + z, the reach ri + rj plus the extra range)
+        let mut touch = [true; LANES];
+        if DENSE {
+            let r2 = (s.xi - s.xj).norm_squared();
+            let mut reach = s.ri + s.rj;
+            if C::NONCONTACT {
+                reach += F8(std::array::from_fn(|l| coeffs.p[l].extra_range));
+            }
+            let rr = reach * reach;
+            for l in 0..count {
+                let apart = r2.0[l] >= rr.0[l];
+                touch[l] = !apart & (r2.0[l] != 0.0);
+                let q = queue[l] - k.ps;
+                lv[q] = ((lv[q] & 1) << 2) | (!apart) as u8;
+            }
+        }
         let c = contact_lanes(s, k.dt);
         let o = self.apply_lanes(&c, &coeffs, &mut hist[..w]);
         let fi = o.force_i(&c);
         let vir = (s.xi - s.xj).dot(&fi);
         for l in 0..count {
+            if DENSE && !touch[l] {
+                continue;
+            }
             let pk = queue[l];
             let (i, j) = (k.a[pk] as usize, k.b[pk] as usize);
             let hk = &mut h[(pk - k.ps) * w..(pk - k.ps + 1) * w];
@@ -1024,6 +1111,16 @@ mod tests {
     /// Several passes of `laws` (positions advanced by the velocities in
     /// between, so history builds up and pairs come apart); forces, torques,
     /// history and virial of each pass.
+    /// [`passes`] with every block in batches of consecutive pairs.
+    fn dense_passes<K: ContactKernel>(laws: &K, table: &ParamTable) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
+        DENSE_ONLY.on_during(|| passes(laws, table, false))
+    }
+    /// The walked, the dense and the per-contact pass give the same bits.
+    fn same_bits_every_way<K: ContactKernel>(laws: &K, table: &ParamTable) {
+        let scalar = passes(laws, table, true);
+        assert_eq!(passes(laws, table, false), scalar);
+        assert_eq!(dense_passes(laws, table), scalar);
+    }
     fn passes<K: ContactKernel>(laws: &K, table: &ParamTable, scalar: bool) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
         let (mut p, dom) = random_bed(11);
         let mut pl = PairList { block: 128, ..Default::default() };
@@ -1090,6 +1187,7 @@ mod tests {
             q.limit_damping = if s == 4 { 1.0 } else { 0.0 };
         });
         let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
+        assert_eq!(dense_passes(&laws, &table), scalar);
         for (st, (b, s)) in batched.iter().zip(&scalar).enumerate() {
             for (n, (x, y)) in [(&b.0, &s.0), (&b.1, &s.1), (&b.2, &s.2)].iter().enumerate() {
                 if let Some(q) = x.iter().zip(y.iter()).position(|(u, v)| u != v) {
@@ -1112,7 +1210,7 @@ mod tests {
             q.gamma_t = if s == 3 { 0.0 } else { 25.0 };
             q.mu = if s == 3 { 0.05 } else { 0.5 };
         });
-        assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
+        same_bits_every_way(&laws, &table);
         // LIGGGHTS hertz + history + cohesion sjkr + rolling_friction epsd2
         use crate::physics::cohesion::sjkr::LiggghtsSjkr;
         use crate::physics::rolling::epsd2::LiggghtsEpsd2;
@@ -1133,6 +1231,7 @@ mod tests {
         });
         let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
         assert_eq!(batched, scalar);
+        assert_eq!(dense_passes(&laws, &table), scalar);
         assert!(scalar.last().unwrap().1.iter().any(|&t| t != 0));
         // LIGGGHTS hooke (k_n from the characteristic velocity) + history
         use crate::physics::normal::hooke::LiggghtsHooke;
@@ -1144,7 +1243,7 @@ mod tests {
             q.mu = 0.3;
             q.tangential_damping = 1.0;
         });
-        assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
+        same_bits_every_way(&laws, &table);
         // LIGGGHTS hooke/stiffness + history
         use crate::physics::normal::hooke_stiffness::LiggghtsHookeStiffness;
         let laws = Laws {
@@ -1161,7 +1260,7 @@ mod tests {
             q.mu = 0.3;
             q.tangential_damping = 1.0;
         });
-        assert_eq!(passes(&laws, &table, false), passes(&laws, &table, true));
+        same_bits_every_way(&laws, &table);
         // the paper's model: viscoelastic Hertz (A_n computed at first
         // touch), Cundall-Strack on the total, EPSD rolling, and van der
         // Waals reaching across gaps up to D_max (a reach per type pair)
@@ -1189,11 +1288,13 @@ mod tests {
         });
         let (batched, scalar) = (passes(&laws, &table, false), passes(&laws, &table, true));
         assert_eq!(batched, scalar);
+        assert_eq!(dense_passes(&laws, &table), scalar);
         // with the attraction in the caps (tangential_reduce on): same bits
         // both ways, and a different result (the caps bind in this bed)
         let reduced = Laws { cohesion: Hamaker { tangential_reduce: true }, ..laws };
         let (batched_r, scalar_r) = (passes(&reduced, &table, false), passes(&reduced, &table, true));
         assert_eq!(batched_r, scalar_r);
+        assert_eq!(dense_passes(&reduced, &table), scalar_r);
         assert_ne!(batched_r, batched, "tangential_reduce changed nothing");
         // pairs within D_max but apart exist in the bed, so the lanes' apart
         // branch is exercised
