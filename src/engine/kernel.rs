@@ -595,6 +595,23 @@ fn prefetch<T>(s: &[T], k: usize) {
     let _ = (s, k);
 }
 
+/// Ask the cache for the partner of the block's pair `q + PREFETCH_AHEAD`
+/// and that pair's history (`w` values a pair). Partners lie later in
+/// storage, those across a block boundary often far later (the spatial
+/// order keeps most neighbours close in memory, not all), and on beds
+/// beyond the cache each first touch of one waits on DRAM.
+#[inline(always)]
+fn prefetch_ahead(k: &Block<'_>, h: &[f64], q: usize, w: usize) {
+    let ahead = k.b[(k.ps + q + PREFETCH_AHEAD).min(k.pe.saturating_sub(1))] as usize;
+    let p = k.p;
+    prefetch(p.x, ahead);
+    prefetch(p.v, ahead);
+    prefetch(p.omega, ahead);
+    prefetch(p.radius, ahead);
+    prefetch(p.mass, ahead);
+    prefetch(h, (q + PREFETCH_AHEAD) * w);
+}
+
 /// Bit of `PairList::live` during a block's walk: the history may have
 /// been non-zero before this pass.
 const WAS_LIVE: u8 = 4;
@@ -651,10 +668,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     }
 
     /// One block of the batched pass. The same contributions, added in the
-    /// same order, as the per-contact pass: pairs apart are sorted out one by
-    /// one, touching ones are queued in increasing index, and each full
-    /// queue runs the laws on [`LANES`] contacts at once and then adds the
-    /// lanes' forces in queue order.
+    /// same order, as the per-contact pass: the laws run on [`LANES`]
+    /// contacts at once and the lanes' forces are added in pair order, the
+    /// touching pairs sorted out by a walk ([`Self::block_walk`]) or, where
+    /// most touched at the last pass, by each batch of consecutive pairs
+    /// ([`Self::block_dense`]). Then the history of pairs that came apart is
+    /// cleared.
     #[inline(always)]
     fn block_batched(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
         // most pairs touched at the last pass (a bed at rest): batches of
@@ -681,7 +700,6 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// the same contributions in the same order as [`Self::block_walk`].
     #[inline(always)]
     fn block_dense(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
-        let p = k.p;
         let w = Self::WIDTH;
         let (lo, len) = (k.lo, f.len());
         let mut queue = [0usize; LANES];
@@ -690,19 +708,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let mut lanes = BatchLanes::new();
         let mut virial = 0.0;
         let n = k.pe - k.ps;
-        let last = k.pe.saturating_sub(1);
         let mut q0 = 0;
         while q0 < n {
             let count = (n - q0).min(LANES);
             for l in 0..count {
                 let q = q0 + l;
-                let ahead = k.b[(k.ps + q + PREFETCH_AHEAD).min(last)] as usize;
-                prefetch(&p.x, ahead);
-                prefetch(&p.v, ahead);
-                prefetch(&p.omega, ahead);
-                prefetch(&p.radius, ahead);
-                prefetch(&p.mass, ahead);
-                prefetch(h, (q + PREFETCH_AHEAD) * w);
+                prefetch_ahead(k, h, q, w);
                 queue[l] = k.ps + q;
                 slots[l] = slot;
                 slot += ((k.b[k.ps + q] as usize).wrapping_sub(lo) >= len) as usize;
@@ -735,19 +746,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let one_type = k.table.ntypes == 1;
         let extra0 = if C::NONCONTACT { k.table.get(1, 1).extra_range } else { 0.0 };
         let pairs = k.a[k.ps..k.pe].iter().zip(&k.b[k.ps..k.pe]).zip(&k.image[k.ps..k.pe]);
-        let last = k.pe.saturating_sub(1);
         for (q, ((&i, &j), &img)) in pairs.enumerate() {
-            // the partner a few pairs ahead: partners lie later in storage,
-            // those across a block boundary often far later (the spatial
-            // order keeps most neighbours close in memory, not all), and on
-            // beds beyond the cache each first touch of one waits on DRAM
-            let ahead = k.b[(k.ps + q + PREFETCH_AHEAD).min(last)] as usize;
-            prefetch(&p.x, ahead);
-            prefetch(&p.v, ahead);
-            prefetch(&p.omega, ahead);
-            prefetch(&p.radius, ahead);
-            prefetch(&p.mass, ahead);
-            prefetch(h, (q + PREFETCH_AHEAD) * w);
+            prefetch_ahead(k, h, q, w);
             let (i, j) = (i as usize, j as usize);
             let xj = p.x[j] + k.images[img as usize];
             let reach = if C::NONCONTACT {
