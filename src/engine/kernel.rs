@@ -1108,9 +1108,6 @@ mod tests {
         (p, dom)
     }
 
-    /// Several passes of `laws` (positions advanced by the velocities in
-    /// between, so history builds up and pairs come apart); forces, torques,
-    /// history and virial of each pass.
     /// [`passes`] with every block in batches of consecutive pairs.
     fn dense_passes<K: ContactKernel>(laws: &K, table: &ParamTable) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
         DENSE_ONLY.on_during(|| passes(laws, table, false))
@@ -1121,6 +1118,9 @@ mod tests {
         assert_eq!(passes(laws, table, false), scalar);
         assert_eq!(dense_passes(laws, table), scalar);
     }
+    /// Several passes of `laws` (positions advanced by the velocities in
+    /// between, so history builds up and pairs come apart); forces, torques,
+    /// history and virial of each pass.
     fn passes<K: ContactKernel>(laws: &K, table: &ParamTable, scalar: bool) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
         let (mut p, dom) = random_bed(11);
         let mut pl = PairList { block: 128, ..Default::default() };
