@@ -546,9 +546,32 @@ fn fused_blocks<'a>(
     // tests take the passes last block first: any order is valid
     let reversed = REVERSED_PASSES.is_on();
     let take = |q: usize| jobs[q].lock().unwrap_or_else(PoisonError::into_inner).take();
+    // blocks claimed whose pass or finishes are still running
+    let busy = AtomicUsize::new(0);
     let work = || loop {
-        let q = next.fetch_add(1, Ordering::Relaxed);
+        // counted busy before the claim: a thread whose claim comes up
+        // empty sees every block claimed before it as busy until done
+        // (the guard counts it done however the block ends, a panic too,
+        // so that no thread waits for it for ever)
+        let held = Busy::hold(&busy);
+        let q = next.fetch_add(1, Ordering::AcqRel);
         if q >= nb {
+            drop(held);
+            // Wait for the other threads' last blocks here, awake, rather
+            // than in rayon's join, which puts a thread that waits long
+            // enough to sleep on a futex: on bed (a) at 2 threads the
+            // step's owner slept ~15% of the loop, and each wake-up is a
+            // VM exit on the critical path. A block's work is at most
+            // ~100 µs; after a short spin the core is yielded to the OS.
+            let mut spins = 0u32;
+            while busy.load(Ordering::Acquire) > 0 {
+                spins = spins.saturating_add(1);
+                if spins < 1024 {
+                    std::hint::spin_loop();
+                } else {
+                    std::thread::yield_now();
+                }
+            }
             break;
         }
         let q = if reversed { nb - 1 - q } else { q };
@@ -564,6 +587,7 @@ fn fused_blocks<'a>(
                 finish(s, f, tq);
             }
         }
+        drop(held);
     };
     if nb > 1 && rayon::current_num_threads() > 1 {
         (0..rayon::current_num_threads()).into_par_iter().for_each(|_| work());
@@ -571,6 +595,23 @@ fn fused_blocks<'a>(
         work();
     }
     virial.iter().map(|v| f64::from_bits(v.load(Ordering::Relaxed))).collect()
+}
+
+/// One block claimed and not yet done (see `fused_blocks`): counted in
+/// `busy` while the guard lives.
+struct Busy<'a>(&'a std::sync::atomic::AtomicUsize);
+
+impl<'a> Busy<'a> {
+    fn hold(busy: &'a std::sync::atomic::AtomicUsize) -> Busy<'a> {
+        busy.fetch_add(1, std::sync::atomic::Ordering::AcqRel);
+        Busy(busy)
+    }
+}
+
+impl Drop for Busy<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, std::sync::atomic::Ordering::AcqRel);
+    }
 }
 
 /// History values per contact the batched pass holds in lanes; wider
