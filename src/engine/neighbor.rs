@@ -695,38 +695,39 @@ impl PairList {
     /// history.
     pub fn prune<F: Fn(usize, usize) -> f64 + Sync>(&mut self, p: &Particles, s: &NeighSettings, buffer: f64, step: i64, extra_range: &F) {
         let n = p.len();
-        let mut x_pruned = vec![];
+        // the last prune's buffer, written over (no fresh pages to fault in)
+        let mut x_pruned = std::mem::take(&mut self.x_pruned);
         let mut half = 0.0;
         let listed = self.listed();
         if buffer < PRUNE_MAX * s.skin && buffer > 0.0 && n > 0 && !NO_PRUNE.is_on() && self.x_built.len() == n && self.prune_pays(step) {
             // positions in single precision and their largest rounding
             // error, which the check's limit leaves room for
-            // (in fixed chunks, in parallel; the largest error is a maximum,
-            // the same on any thread count)
+            // (in fixed chunks, in parallel, written in place; the largest
+            // error is a maximum, the same on any thread count)
             let (x0, x) = (&self.x_built[..], &p.x[..]);
-            let parts = in_chunks(n, CHUNK, |r| {
+            let fill = |c: usize, out: &mut [[f32; 4]]| -> f64 {
+                let lo = c * CHUNK;
                 let mut eps2: f64 = 0.0;
-                let xp: Vec<[f32; 4]> = x[r.clone()]
-                    .iter()
-                    .zip(&x0[r])
-                    .map(|(x, x0)| {
-                        let q = [x.x as f32, x.y as f32, x.z as f32];
-                        let d = [x.x - q[0] as f64, x.y - q[1] as f64, x.z - q[2] as f64];
-                        eps2 = eps2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                        // the distance from the build, rounded up twice over
-                        let e = [q[0] as f64 - x0.x, q[1] as f64 - x0.y, q[2] as f64 - x0.z];
-                        let e = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() * (1.0 + 1e-9);
-                        let up = e as f32;
-                        [q[0], q[1], q[2], if (up as f64) < e { up.next_up() } else { up }]
-                    })
-                    .collect();
-                (xp, eps2)
-            });
-            let eps2 = parts.iter().map(|c| c.1).fold(0.0, f64::max);
-            x_pruned = Vec::with_capacity(n);
-            for (xp, _) in &parts {
-                x_pruned.extend_from_slice(xp);
-            }
+                for ((o, x), x0) in out.iter_mut().zip(&x[lo..]).zip(&x0[lo..]) {
+                    let q = [x.x as f32, x.y as f32, x.z as f32];
+                    let d = [x.x - q[0] as f64, x.y - q[1] as f64, x.z - q[2] as f64];
+                    eps2 = eps2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    // the distance from the build, rounded up twice over
+                    let e = [q[0] as f64 - x0.x, q[1] as f64 - x0.y, q[2] as f64 - x0.z];
+                    let e = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() * (1.0 + 1e-9);
+                    let up = e as f32;
+                    *o = [q[0], q[1], q[2], if (up as f64) < e { up.next_up() } else { up }];
+                }
+                eps2
+            };
+            // every entry is written below: a buffer of the right length
+            // is not cleared first
+            x_pruned.resize(n, [0.0; 4]);
+            let eps2 = if n > CHUNK {
+                x_pruned.par_chunks_mut(CHUNK).enumerate().map(|(c, out)| fill(c, out)).reduce(|| 0.0, f64::max)
+            } else {
+                fill(0, &mut x_pruned[..])
+            };
             // a relative margin for the rounding of the distances themselves
             half = 0.5 * buffer * (1.0 - 1e-9) - eps2.sqrt();
         }
@@ -736,7 +737,8 @@ impl PairList {
             } else {
                 self.live_from_history();
             }
-            self.x_pruned.clear();
+            x_pruned.clear();
+            self.x_pruned = x_pruned;
         } else {
             let images = std::mem::take(&mut self.images);
             self.refilter(|i, j, img| {
@@ -749,14 +751,15 @@ impl PairList {
             if !pays(self.kept) {
                 self.retry_in = PRUNE_RETRY;
             }
+            if self.outer.is_none() {
+                x_pruned.clear();
+            }
+            self.x_pruned = x_pruned;
             if self.outer.is_some() {
-                self.x_pruned = x_pruned;
                 self.prune_lim = half * half;
                 self.buffer = buffer;
                 self.pruned_at = step;
                 self.prunes += 1;
-            } else {
-                self.x_pruned.clear();
             }
         }
         // `refilter` set the live flags
