@@ -994,31 +994,26 @@ impl PairList {
         // the cross pass, particle after particle, reads each block's range
         // in order instead of at random. Blocks in parallel.
         let (b, starts) = (&self.b[..], &self.block_start[..]);
-        let block = |q: usize| -> (Vec<u32>, Vec<u32>) {
-            let ks: Vec<u32> = (starts[q]..starts[q + 1]).filter(|&k| b[k as usize] as usize >> sh != q).collect();
-            let mut by_b: Vec<u32> = (0..ks.len() as u32).collect();
-            by_b.sort_by_key(|&c| b[ks[c as usize] as usize]);
-            let mut place = vec![0u32; ks.len()];
-            for (r, &c) in by_b.iter().enumerate() {
-                place[c as usize] = r as u32;
-            }
-            (ks, place)
-        };
-        let per = in_chunks(nblocks, 1, |r| block(r.start));
-        self.block_cross = std::iter::once(0).chain(per.iter().scan(0u32, |c, (ks, _)| {
-            *c += ks.len() as u32;
-            Some(*c)
-        })).collect();
-        // the force pass finds the n-th cross pair of its walk at `xslot[n]`
-        self.xslot.clear();
-        for (_, place) in &per {
-            self.xslot.extend_from_slice(place);
-        }
+        let per: Vec<Vec<u32>> = in_chunks(nblocks, 1, |r| {
+            let q = r.start;
+            (starts[q]..starts[q + 1]).filter(|&k| b[k as usize] as usize >> sh != q).collect()
+        });
+        self.block_cross = std::iter::once(0)
+            .chain(per.iter().scan(0u32, |c, ks| {
+                *c += ks.len() as u32;
+                Some(*c)
+            }))
+            .collect();
+        let total = *self.block_cross.last().unwrap_or(&0) as usize;
         // each particle lists the slots where it is b, in increasing pair
         // index (the order its shares are added): blocks in order, each
-        // block's cross pairs in pair order
-        let mut ccount = vec![0u32; n + 1];
-        for (ks, _) in &per {
+        // block's cross pairs in pair order. A counting sort by b: the
+        // entries in that order are also each block's cross pairs sorted by
+        // b, then pair index, which numbers the places (no sort per block)
+        let mut ccount = std::mem::take(&mut self.cross_start);
+        ccount.clear();
+        ccount.resize(n + 1, 0);
+        for ks in &per {
             for &k in ks {
                 ccount[b[k as usize] as usize + 1] += 1;
             }
@@ -1026,18 +1021,42 @@ impl PairList {
         for i in 0..n {
             ccount[i + 1] += ccount[i];
         }
+        // the entry at each place of the sorted order: its cross pair's
+        // number among all (the block's base plus its rank in the block)
         let mut fill = ccount.clone();
-        self.cross.clear();
-        self.cross.resize(self.xslot.len(), 0);
-        self.cross_b.clear();
-        self.cross_b.resize(self.xslot.len(), 0);
-        for (q, (ks, place)) in per.iter().enumerate() {
-            for (&k, &r) in ks.iter().zip(place) {
+        let mut at = vec![0u32; total];
+        for (q, ks) in per.iter().enumerate() {
+            let base = self.block_cross[q];
+            for (c, &k) in ks.iter().enumerate() {
                 let i = b[k as usize] as usize;
-                self.cross[fill[i] as usize] = self.block_cross[q] + r;
-                self.cross_b[fill[i] as usize] = i as u32;
+                at[fill[i] as usize] = base + c as u32;
                 fill[i] += 1;
             }
+        }
+        // the force pass finds the n-th cross pair of its walk at
+        // `xslot[n]`: its place in the block's range (the slot less the
+        // block's base)
+        self.xslot.clear();
+        self.xslot.resize(total, 0);
+        self.cross.clear();
+        self.cross.resize(total, 0);
+        self.cross_b.clear();
+        self.cross_b.resize(total, 0);
+        let mut next = self.block_cross[..nblocks].to_vec();
+        let block_of = |e: u32| self.block_cross.partition_point(|&c| c <= e) - 1;
+        let mut q = 0;
+        for (pos, &e) in at.iter().enumerate() {
+            // blocks are few: find the entry's by a search only when it is
+            // not the last one's
+            if !(self.block_cross[q] <= e && e < self.block_cross[q + 1]) {
+                q = block_of(e);
+            }
+            let slot = next[q];
+            next[q] += 1;
+            self.xslot[e as usize] = slot - self.block_cross[q];
+            self.cross[pos] = slot;
+            let k = per[q][(e - self.block_cross[q]) as usize];
+            self.cross_b[pos] = b[k as usize];
         }
         self.cross_start = ccount;
         // which blocks each block's pairs reach
@@ -1048,7 +1067,7 @@ impl PairList {
         self.block_deps.resize(nblocks, 1);
         self.forward = true;
         let mut reach: Vec<u32> = Vec::new();
-        for (q, (ks, _)) in per.iter().enumerate() {
+        for (q, ks) in per.iter().enumerate() {
             reach.clear();
             reach.extend(ks.iter().map(|&k| (b[k as usize] as usize >> sh) as u32));
             reach.sort_unstable();
