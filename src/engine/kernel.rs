@@ -1059,8 +1059,9 @@ mod tests {
         w
     }
 
-    #[test]
-    fn forces_are_equal_and_opposite_and_thread_count_independent() {
+    /// 400 spheres at random in a periodic box of side 3, a linear spring
+    /// between them.
+    fn spring_gas() -> (Domain, Particles, ParamTable, Laws<Spring, Frictionless, NoCohesion, NoRolling>) {
         let dom = Domain::new([0.0; 3], [3.0; 3], [[Side::Periodic; 2]; 3], 3);
         let mut p = Particles::default();
         let mut s = 7u64;
@@ -1080,7 +1081,39 @@ mod tests {
         }
         let mut table = ParamTable::new(1);
         table.get_mut(1, 1).kn = 100.0;
-        let laws = Laws { normal: Spring, tangential: Frictionless, cohesion: NoCohesion, rolling: NoRolling };
+        (dom, p, table, Laws { normal: Spring, tangential: Frictionless, cohesion: NoCohesion, rolling: NoRolling })
+    }
+
+    /// A block whose finish panics on one of two threads: the panic reaches
+    /// the caller, and the other thread, out of blocks and waiting awake for
+    /// the busy ones, is not left waiting for it for ever.
+    #[test]
+    fn a_panicking_block_does_not_hang_the_fused_pass() {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let (dom, p, table, laws) = spring_gas();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+            let outcome = pool.install(|| {
+                let mut pl = PairList { block: 64, ..Default::default() };
+                pl.build(&p, &dom, &NeighSettings { skin: 0.05, ..Default::default() }, 0, &laws.history_signs(), |_, _| 0.0);
+                let (mut hist, mut live) = pl.take_history();
+                let (mut f, mut t, mut defer) = (vec![V3::zeros(); p.len()], vec![V3::zeros(); p.len()], vec![]);
+                let tail = |b: usize, _: &mut [V3], _: &mut [V3]| assert_ne!(b, 3, "block 3 fails");
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    let force = Forces { f: &mut f, torque: &mut t, defer: &mut defer };
+                    laws.force_pass(&PassState::of(&p), &pl, &mut hist, &mut live, &table, 1e-3, force, Some(&tail as &Tail<'_>))
+                }))
+                .is_err()
+            });
+            let _ = tx.send(outcome);
+        });
+        let panicked = rx.recv_timeout(std::time::Duration::from_secs(60)).expect("the fused pass hung after a block panicked");
+        assert!(panicked, "the block's panic did not reach the caller");
+    }
+
+    #[test]
+    fn forces_are_equal_and_opposite_and_thread_count_independent() {
+        let (dom, p, table, laws) = spring_gas();
         // blocks of 64 particles: 7 blocks, many pairs across blocks
         let run_as = |threads: usize, block: usize, fused: bool, reversed: bool| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
