@@ -738,7 +738,6 @@ impl PairList {
                 self.live_from_history();
             }
             x_pruned.clear();
-            self.x_pruned = x_pruned;
         } else {
             let images = std::mem::take(&mut self.images);
             self.refilter(|i, j, img| {
@@ -751,17 +750,16 @@ impl PairList {
             if !pays(self.kept) {
                 self.retry_in = PRUNE_RETRY;
             }
-            if self.outer.is_none() {
-                x_pruned.clear();
-            }
-            self.x_pruned = x_pruned;
             if self.outer.is_some() {
                 self.prune_lim = half * half;
                 self.buffer = buffer;
                 self.pruned_at = step;
                 self.prunes += 1;
+            } else {
+                x_pruned.clear();
             }
         }
+        self.x_pruned = x_pruned;
         // `refilter` set the live flags
         self.index_blocks(n);
     }
@@ -1021,42 +1019,33 @@ impl PairList {
         for i in 0..n {
             ccount[i + 1] += ccount[i];
         }
-        // the entry at each place of the sorted order: its cross pair's
-        // number among all (the block's base plus its rank in the block)
+        // the entry at each place of the sorted order: its block and its
+        // rank among the block's cross pairs in pair order
         let mut fill = ccount.clone();
-        let mut at = vec![0u32; total];
+        let mut at = vec![(0u32, 0u32); total];
+        self.cross_b.clear();
+        self.cross_b.resize(total, 0);
         for (q, ks) in per.iter().enumerate() {
-            let base = self.block_cross[q];
             for (c, &k) in ks.iter().enumerate() {
-                let i = b[k as usize] as usize;
-                at[fill[i] as usize] = base + c as u32;
-                fill[i] += 1;
+                let i = b[k as usize];
+                at[fill[i as usize] as usize] = (q as u32, c as u32);
+                self.cross_b[fill[i as usize] as usize] = i;
+                fill[i as usize] += 1;
             }
         }
-        // the force pass finds the n-th cross pair of its walk at
-        // `xslot[n]`: its place in the block's range (the slot less the
-        // block's base)
+        // in that order, each block's entries come sorted by b, then pair
+        // index: their places in the block's range, counted. The force pass
+        // finds the n-th cross pair of its walk at `xslot[n]`, its place.
         self.xslot.clear();
         self.xslot.resize(total, 0);
         self.cross.clear();
         self.cross.resize(total, 0);
-        self.cross_b.clear();
-        self.cross_b.resize(total, 0);
-        let mut next = self.block_cross[..nblocks].to_vec();
-        let block_of = |e: u32| self.block_cross.partition_point(|&c| c <= e) - 1;
-        let mut q = 0;
-        for (pos, &e) in at.iter().enumerate() {
-            // blocks are few: find the entry's by a search only when it is
-            // not the last one's
-            if !(self.block_cross[q] <= e && e < self.block_cross[q + 1]) {
-                q = block_of(e);
-            }
-            let slot = next[q];
+        let mut next = vec![0u32; nblocks];
+        for (pos, &(q, c)) in at.iter().enumerate() {
+            let (q, base) = (q as usize, self.block_cross[q as usize]);
+            self.xslot[(base + c) as usize] = next[q];
+            self.cross[pos] = base + next[q];
             next[q] += 1;
-            self.xslot[e as usize] = slot - self.block_cross[q];
-            self.cross[pos] = slot;
-            let k = per[q][(e - self.block_cross[q]) as usize];
-            self.cross_b[pos] = b[k as usize];
         }
         self.cross_start = ccount;
         // which blocks each block's pairs reach
