@@ -507,13 +507,14 @@ impl PairList {
             t.pruned = x.iter().zip(xp).map(|(x, p)| d2(x, p)).fold(0.0, max);
             return t;
         };
-        // |x - x_built| <= |x - x_pruned| + |x_pruned - x_built|; the
-        // relative margin covers the rounding of both sides' sums. One pass
-        // carries both maxima (each distance from the prune computed once).
-        let (pruned, bound) = x.iter().zip(xp).fold((0.0, 0.0), |(m, b), (x, p)| {
-            let d = d2(x, p);
-            (max(m, d), max(b, d.sqrt() + p[3] as f64))
-        });
+        // |x - x_built| <= |x - x_pruned| + |x_pruned - x_built|, and over
+        // the chunk at most the largest of the first plus the largest of the
+        // second: one square root per chunk, not per particle (a chunk whose
+        // bound passes the limit measures exactly). The relative margin
+        // covers the rounding of both sides' sums. One pass carries both
+        // maxima (each distance from the prune computed once).
+        let (pruned, far) = x.iter().zip(xp).fold((0.0, 0.0f32), |(m, b), (x, p)| (max(m, d2(x, p)), if p[3] > b { p[3] } else { b }));
+        let bound = pruned.sqrt() + far as f64;
         let bound = bound * bound * (1.0 + 1e-9);
         t.pruned = pruned;
         t.built = if bound <= lim { bound } else { exact(x) };
