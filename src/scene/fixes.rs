@@ -174,6 +174,16 @@ impl Pull {
     #[inline(always)]
     fn pull(&self, f: &mut [V3], mask: &[u32], mass: &[f64]) {
         let acc = self.acc;
+        // the whole chunk in the group (the common case): every force
+        // written, which compiles to plain vector loads and stores; the
+        // conditional form below compiles, where AVX-512 is enabled, to
+        // masked scatters, microcoded on AMD Zen 4 (2.4% of bed (a)'s run)
+        if mask.iter().all(|&bits| bits & self.group != 0) {
+            for (f, &m) in f.iter_mut().zip(mass) {
+                *f += V3::new(m * acc.x, m * acc.y, m * acc.z);
+            }
+            return;
+        }
         for ((f, &bits), &m) in f.iter_mut().zip(mask).zip(mass) {
             if bits & self.group != 0 {
                 // LAMMPS FixGravity: f += rmass * xacc (per component)
