@@ -39,6 +39,16 @@ struct Half<'a> {
 
 /// Apply `step(i, x, v, omega)` to every particle of `group`, in chunks of
 /// CHUNK particles, in parallel when there are several.
+/// Whether every particle of `mask` is in `group` (one bit): their AND
+/// holds it. Without `all`'s early exit it runs on vectors. A stage that
+/// tests each particle's bit in its loop keeps the loop scalar (and, with
+/// AVX-512, may turn its stores into masked scatters); where this holds it
+/// can leave the test out.
+#[inline]
+pub fn all_in_group(mask: &[u32], group: u32) -> bool {
+    mask.iter().fold(u32::MAX, |a, &b| a & b) & group != 0
+}
+
 fn each_in_group<F>(p: &mut Particles, group: u32, step: F)
 where
     F: Fn(&Half<'_>, usize, &mut V3, &mut V3, &mut V3) + Sync,
@@ -219,9 +229,9 @@ impl Stage for Halves {
             }
         }
         let each = c.x.iter_mut().zip(c.v.iter_mut()).zip(c.omega.iter_mut()).zip(c.f.iter().zip(c.torque.iter())).zip(mass.iter().zip(radius));
-        // the whole chunk in the group (a group is one bit): no test per
-        // particle, so the loop runs on vectors (its divisions among them)
-        if mask.iter().fold(u32::MAX, |a, &b| a & b) & self.group != 0 {
+        // the whole chunk in the group: no test per particle, so the loop
+        // runs on vectors (its divisions among them)
+        if all_in_group(mask, self.group) {
             for ((((x, v), w), (f, t)), (&m, &r)) in each {
                 one(dt, dtf, rotate, m, r, *f, *t, x, v, w);
             }
