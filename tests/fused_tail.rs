@@ -10,7 +10,8 @@
 //! the run with every hook called on its own write the same dump bytes. A
 //! second deck gives gravity a variable magnitude, which its hook evaluates
 //! itself (not fused), between fused stages; a third adds a moving mesh,
-//! whose initial_integrate needs the whole simulation.
+//! whose initial_integrate needs the whole simulation; a fourth freezes the
+//! bottom layer (`fix freeze`), whose partners then weigh as walls.
 
 use demx::cli::{run_deck, DeckArgs};
 use demx::engine::sim::with_unfused_tail;
@@ -110,6 +111,12 @@ fn fused_head_and_tail_change_no_bit() {
     let fused_mesh = run(gravity, mesh, true);
     same(&fused_mesh, &run(gravity, mesh, false), "moving mesh");
     assert_ne!(fused_mesh, fused, "the mesh changed nothing");
+    // a frozen bottom layer: the fused pass, like the pass of the hooks on
+    // their own, gives their partners an infinite mass
+    let freeze = "group low id <= 225\nvelocity low set 0 0 0\nfix fr low freeze";
+    let fused_freeze = run(gravity, freeze, true);
+    same(&fused_freeze, &run(gravity, freeze, false), "frozen layer");
+    assert_ne!(fused_freeze, fused, "the frozen layer changed nothing");
 }
 
 /// A tilted square across the box, 0.1-0.4 mm above the floor: it touches

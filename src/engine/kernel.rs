@@ -199,13 +199,23 @@ pub struct PassState<'a> {
     pub kind: &'a [u32],
     /// Frozen flags.
     pub frozen: &'a [bool],
+    /// Whether any particle is frozen: if not, a contact reads no flag (on a
+    /// bed beyond the cache, each partner's flag was one more line from
+    /// memory).
+    pub any_frozen: bool,
 }
 
 impl<'a> PassState<'a> {
     /// The pass's view of `p`.
     pub fn of(p: &'a Particles) -> PassState<'a> {
-        PassState { x: &p.x, v: &p.v, omega: &p.omega, radius: &p.radius, mass: &p.mass, kind: &p.kind, frozen: &p.frozen }
+        PassState { x: &p.x, v: &p.v, omega: &p.omega, radius: &p.radius, mass: &p.mass, kind: &p.kind, frozen: &p.frozen, any_frozen: any(&p.frozen) }
     }
+}
+
+/// Whether any flag is set: a fold without an early exit, which the
+/// compiler turns into vector ORs.
+pub fn any(flags: &[bool]) -> bool {
+    flags.iter().fold(false, |a, &b| a | b)
 }
 
 /// What the step does with a block once its forces are complete: called
@@ -272,7 +282,7 @@ pub fn contact_lanes<L: Real>(s: &PairState<L>, dt: f64) -> ContactL<L> {
 /// A particle's mass as its contacts see it: infinite when frozen.
 #[inline(always)]
 fn contact_mass(p: &PassState<'_>, k: usize) -> f64 {
-    if p.frozen[k] {
+    if p.any_frozen && p.frozen[k] {
         f64::INFINITY
     } else {
         p.mass[k]
@@ -845,7 +855,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let w = Self::WIDTH;
         let BatchLanes { s, hist } = lanes;
         let one_type = k.table.ntypes == 1;
-        let p0 = k.table.get(p.kind[k.a[queue[0]] as usize], p.kind[k.b[queue[0]] as usize]);
+        // with one type, types are not read (as in the walk): each batch's
+        // first partner's type was a line from memory on a large bed
+        let p0 = if one_type { k.table.get(1, 1) } else { k.table.get(p.kind[k.a[queue[0]] as usize], p.kind[k.b[queue[0]] as usize]) };
         let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
         let put = |v: &mut Vec3<F8>, l: usize, x: &V3| {
             v.x.0[l] = x.x;
@@ -1196,7 +1208,11 @@ mod tests {
     /// between, so history builds up and pairs come apart); forces, torques,
     /// history and virial of each pass.
     fn passes<K: ContactKernel>(laws: &K, table: &ParamTable, scalar: bool) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
-        let (mut p, dom) = random_bed(11);
+        passes_on(laws, table, scalar, random_bed(11))
+    }
+
+    /// [`passes`] on the bed `(p, dom)`.
+    fn passes_on<K: ContactKernel>(laws: &K, table: &ParamTable, scalar: bool, (mut p, dom): (Particles, Domain)) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
         let mut pl = PairList { block: 128, ..Default::default() };
         let settings = NeighSettings { skin: 0.05, ..Default::default() };
         let mut out = vec![];
@@ -1240,6 +1256,41 @@ mod tests {
             fill(table.get_mut(a, b), a + b);
         }
         table
+    }
+
+    /// A frozen particle meets its contacts with an infinite mass, in both
+    /// passes, and a pass reads the flags only when some particle is frozen.
+    #[test]
+    fn frozen_partners_weigh_as_infinite_masses() {
+        use crate::physics::normal::gran::LammpsGranHooke;
+        use crate::physics::tangential::gran::LammpsGranHistory;
+        // gran/hooke damps with the effective mass, which a frozen partner
+        // makes the other's alone
+        let laws = Laws { normal: LammpsGranHooke, tangential: LammpsGranHistory, cohesion: NoCohesion, rolling: NoRolling };
+        let table = two_type_table(|q, s| {
+            q.kn = 1e4 * s as f64;
+            q.kt = 3e3 * s as f64;
+            q.gamma_n = 50.0;
+            q.gamma_t = 25.0;
+            q.mu = 0.5;
+        });
+        let bed = random_bed(11);
+        assert!(PassState::of(&bed.0).any_frozen);
+        let mut heavy = bed.clone();
+        for i in 0..heavy.0.len() {
+            if std::mem::take(&mut heavy.0.frozen[i]) {
+                heavy.0.mass[i] = f64::INFINITY;
+            }
+        }
+        assert!(!PassState::of(&heavy.0).any_frozen);
+        let mut light = bed.clone();
+        light.0.frozen.iter_mut().for_each(|f| *f = false);
+        for scalar in [false, true] {
+            let (frozen, heavy, light) =
+                (passes_on(&laws, &table, scalar, bed.clone()), passes_on(&laws, &table, scalar, heavy.clone()), passes_on(&laws, &table, scalar, light.clone()));
+            assert_eq!(frozen, heavy, "scalar pass: {scalar}");
+            assert_ne!(frozen, light, "scalar pass: {scalar}: the frozen flags changed nothing");
+        }
     }
 
     #[test]

@@ -369,6 +369,7 @@ impl Sim {
                 mass,
                 kind,
                 frozen,
+                any_frozen: super::kernel::any(frozen),
             }
         };
         let bs = self.pairs.block_size();
