@@ -1258,22 +1258,29 @@ mod tests {
         table
     }
 
-    /// A frozen particle meets its contacts with an infinite mass, in both
-    /// passes, and a pass reads the flags only when some particle is frozen.
-    #[test]
-    fn frozen_partners_weigh_as_infinite_masses() {
+    /// LAMMPS gran/hooke/history on [`two_type_table`]: one type pair
+    /// without tangential damping and with little friction.
+    fn gran_hooke() -> (Laws<crate::physics::normal::gran::LammpsGranHooke, crate::physics::tangential::gran::LammpsGranHistory, NoCohesion, NoRolling>, ParamTable) {
         use crate::physics::normal::gran::LammpsGranHooke;
         use crate::physics::tangential::gran::LammpsGranHistory;
-        // gran/hooke damps with the effective mass, which a frozen partner
-        // makes the other's alone
         let laws = Laws { normal: LammpsGranHooke, tangential: LammpsGranHistory, cohesion: NoCohesion, rolling: NoRolling };
         let table = two_type_table(|q, s| {
             q.kn = 1e4 * s as f64;
             q.kt = 3e3 * s as f64;
             q.gamma_n = 50.0;
-            q.gamma_t = 25.0;
-            q.mu = 0.5;
+            q.gamma_t = if s == 3 { 0.0 } else { 25.0 };
+            q.mu = if s == 3 { 0.05 } else { 0.5 };
         });
+        (laws, table)
+    }
+
+    /// A frozen particle meets its contacts with an infinite mass, in both
+    /// passes, and a pass reads the flags only when some particle is frozen.
+    #[test]
+    fn frozen_partners_weigh_as_infinite_masses() {
+        // gran/hooke damps with the effective mass, which a frozen partner
+        // makes the other's alone
+        let (laws, table) = gran_hooke();
         let bed = random_bed(11);
         assert!(PassState::of(&bed.0).any_frozen);
         let mut heavy = bed.clone();
@@ -1295,9 +1302,7 @@ mod tests {
 
     #[test]
     fn batched_pass_gives_the_per_contact_bits() {
-        use crate::physics::normal::gran::LammpsGranHooke;
         use crate::physics::normal::hertz::LiggghtsHertz;
-        use crate::physics::tangential::gran::LammpsGranHistory;
         use crate::physics::tangential::history::LiggghtsHistory;
         // LIGGGHTS hertz + history; small mu on one type pair so that some
         // contacts slide and some stick
@@ -1327,14 +1332,7 @@ mod tests {
         let contacts = scalar.last().unwrap().2.chunks(3).filter(|h| h.iter().any(|&v| v != 0)).count();
         assert!(contacts > 100, "only {contacts} contacts with history");
         // LAMMPS gran/hooke/history
-        let laws = Laws { normal: LammpsGranHooke, tangential: LammpsGranHistory, cohesion: NoCohesion, rolling: NoRolling };
-        let table = two_type_table(|q, s| {
-            q.kn = 1e4 * s as f64;
-            q.kt = 3e3 * s as f64;
-            q.gamma_n = 50.0;
-            q.gamma_t = if s == 3 { 0.0 } else { 25.0 };
-            q.mu = if s == 3 { 0.05 } else { 0.5 };
-        });
+        let (laws, table) = gran_hooke();
         same_bits_every_way(&laws, &table);
         // LIGGGHTS hertz + history + cohesion sjkr + rolling_friction epsd2
         use crate::physics::cohesion::sjkr::LiggghtsSjkr;
