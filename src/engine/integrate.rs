@@ -37,8 +37,6 @@ struct Half<'a> {
     mask: &'a [u32],
 }
 
-/// Apply `step(i, x, v, omega)` to every particle of `group`, in chunks of
-/// CHUNK particles, in parallel when there are several.
 /// Whether every particle of `mask` is in `group` (one bit): their AND
 /// holds it. Without `all`'s early exit it runs on vectors. A stage that
 /// tests each particle's bit in its loop keeps the loop scalar (and, with
@@ -49,6 +47,8 @@ pub fn all_in_group(mask: &[u32], group: u32) -> bool {
     mask.iter().fold(u32::MAX, |a, &b| a & b) & group != 0
 }
 
+/// Apply `step(i, x, v, omega)` to every particle of `group`, in chunks of
+/// CHUNK particles, in parallel when there are several.
 fn each_in_group<F>(p: &mut Particles, group: u32, step: F)
 where
     F: Fn(&Half<'_>, usize, &mut V3, &mut V3, &mut V3) + Sync,
