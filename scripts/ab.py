@@ -3,13 +3,16 @@
 
     python3 scripts/ab.py --reps 5 --threads 2 OLD/demx target/release/demx
     python3 scripts/ab.py --reps 6 --side-by-side OLD/demx target/release/demx
+    python3 scripts/ab.py --chute --steps 1000 --side-by-side OLD/demx target/release/demx
 
 Runs each binary in turn, `--reps` rounds, on bench/in.bed.liggghts with the
 tiled bed of scripts/bench.py (target/bench/bed2x2.data, 30,000 spheres; run
 scripts/bench.py once, or its prepare(), to make it), and prints the minimum
 and median of each section time from demx's own log. This machine's speed
 drifts by tens of percent within minutes: interleaving and several rounds
-are what make two binaries comparable.
+are what make two binaries comparable. --chute runs deck (c) instead, the
+LAMMPS chute (target/bench/in.chute and data.chute, which scripts/bench.py
+puts there).
 
 --side-by-side runs two binaries at once, one thread each, each pinned to its
 own core (`taskset`, the cores swapped every round), so that both see the
@@ -30,12 +33,15 @@ def main():
     ap.add_argument("--threads", default="1")
     ap.add_argument("--steps", default="500")
     ap.add_argument("--data", default="bed2x2.data")
+    ap.add_argument("--chute", action="store_true", help="deck (c), the LAMMPS chute, instead of the bed")
     ap.add_argument("--side-by-side", action="store_true", help="two binaries at once, one core each")
     a = ap.parse_args()
     keys = ("Loop", "Pair", "Neigh", "Modify")
     res = {b: {k: [] for k in keys} for b in a.bins}
 
     def cmd(b, threads):
+        if a.chute:
+            return [os.path.abspath(b), "run", "in.chute", "--log", "none", "--threads", threads, "-var", "nsteps", a.steps]
         return [os.path.abspath(b), "run", os.path.join(ROOT, "bench", "in.bed.liggghts"), "--log", "none",
                 "--threads", threads, "-var", "data", a.data, "-var", "nsteps", a.steps]
 

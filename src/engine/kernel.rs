@@ -663,9 +663,20 @@ fn prefetch_ahead(k: &Block<'_>, h: &[f64], q: usize, w: usize) {
     prefetch(h, (q + PREFETCH_AHEAD) * w);
 }
 
-/// Bit of `PairList::live` during a block's walk: the history may have
-/// been non-zero before this pass.
-const WAS_LIVE: u8 = 4;
+/// Set pair `q`'s live flag from the pass's test and clear its history
+/// if it came apart. Few pairs come apart in a step, so the branch is
+/// foreseen (unlike whether a pair touches); a pass over the block's flags
+/// after the walk to find them cost the chute 3% of its run.
+#[inline(always)]
+fn came_apart(h: &mut [f64], lv: &mut [u8], q: usize, w: usize, apart: bool) {
+    // one branch on both (as integers: on bools the compiler tests `apart`
+    // first, the coin toss)
+    let was = lv[q];
+    lv[q] = (!apart) as u8;
+    if was > lv[q] {
+        h[q * w..(q + 1) * w].fill(0.0);
+    }
+}
 
 /// What a block of the batched pass reads.
 struct Block<'a> {
@@ -723,8 +734,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// contacts at once and the lanes' forces are added in pair order, the
     /// touching pairs sorted out by a walk ([`Self::block_walk`]) or, where
     /// most touched at the last pass, by each batch of consecutive pairs
-    /// ([`Self::block_dense`]). Then the history of pairs that came apart is
-    /// cleared.
+    /// ([`Self::block_dense`]). Either clears the history of the pairs that
+    /// came apart as it finds them.
     #[inline(always)]
     fn block_batched(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
         // most pairs touched at the last pass (a bed at rest): batches of
@@ -735,13 +746,6 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         } else {
             self.block_walk(k, h, d, lv, f, tq)
         };
-        let w = Self::WIDTH;
-        for (q, l) in lv.iter_mut().enumerate() {
-            if *l & (WAS_LIVE | 1) == WAS_LIVE {
-                h[q * w..(q + 1) * w].fill(0.0);
-            }
-            *l &= !WAS_LIVE;
-        }
         virial
     }
 
@@ -816,9 +820,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             slots[queued] = slot;
             slot += (j.wrapping_sub(lo) >= len) as usize;
             queued += touch as usize;
-            // the flag's previous state moves to bit 2; pairs that came apart
-            // are cleared after the walk (rare; a branch here would not be)
-            lv[q] = ((lv[q] & 1) << 2) | (!apart) as u8;
+            came_apart(h, lv, q, w, apart);
             if queued == LANES {
                 self.run_batch::<false>(k, &mut lanes, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
                 queued = 0;
@@ -900,8 +902,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             for l in 0..count {
                 let apart = r2.0[l] >= rr.0[l];
                 touch[l] = !apart & (r2.0[l] != 0.0);
-                let q = queue[l] - k.ps;
-                lv[q] = ((lv[q] & 1) << 2) | (!apart) as u8;
+                came_apart(h, lv, queue[l] - k.ps, w, apart);
             }
         }
         let c = contact_lanes(s, k.dt);

@@ -63,8 +63,7 @@ pub struct PairList {
     pub image: Vec<u8>,
     /// The distinct periodic shifts the pairs use.
     pub images: Vec<V3>,
-    /// Per pair: 1 if its history may be non-zero (bit 0; the force pass
-    /// uses one more bit while it runs). A pair found apart with 0 here is
+    /// Per pair: 1 if its history may be non-zero, else 0. A pair found apart with 0 here is
     /// skipped without touching its history: most listed pairs are within
     /// the skin but apart, and stay so. A prune keeps every live pair.
     pub live: Vec<u8>,
