@@ -287,22 +287,41 @@ struct BuildCtx<'a, F> {
     per_particle: usize,
 }
 
+/// The pairs a chunk of particles found over the half stencil
+/// ([`BuildCtx::find`]), before they are put in order.
+struct Found {
+    /// Per particle of the chunk, where its pairs start in `own` (one more
+    /// entry than particles).
+    start: Vec<u32>,
+    /// Pairs whose first particle (the smaller storage index) found them:
+    /// second particle and image.
+    own: Vec<(u32, u8)>,
+    /// Pairs found by their second particle: first particle, second
+    /// particle and the image as seen from the first.
+    foreign: Vec<(u32, u32, u8)>,
+}
+
+/// The image index of the opposite shift (`images[c]` is
+/// `(c % 3 - 1, c / 3 % 3 - 1, c / 9 - 1)` times the box lengths).
+const fn opposite(img: u8) -> u8 {
+    26 - img
+}
+
 impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
-    fn chunk(&self, range: std::ops::Range<usize>) -> Chunk {
-        let (p, s, w) = (self.p, self.s, self.width);
-        // room for the pairs per particle of the last build, plus a margin
-        let room = range.len() * (self.per_particle + 2);
-        let mut out = Chunk {
-            lo: range.start,
-            count: Vec::with_capacity(range.len()),
-            b: Vec::with_capacity(room),
-            image: Vec::with_capacity(room),
-            hist: Vec::with_capacity(room * w),
-        };
+    /// The pairs within reach + skin of each particle of `range` over the
+    /// half stencil ([`Grid::stencil`]): each pair and image is tested
+    /// once, half the candidates of a full stencil. The test is written as
+    /// from the pair's first particle whichever found it (the same
+    /// operations, so the same list as a full stencil tested from there).
+    fn find(&self, range: std::ops::Range<usize>) -> Found {
+        let (p, s) = (self.p, self.s);
+        let room = range.len() * (self.per_particle / 2 + 2);
+        let mut out = Found { start: Vec::with_capacity(range.len() + 1), own: Vec::with_capacity(room), foreign: Vec::with_capacity(room) };
+        out.start.push(0);
         let mut buf: Vec<(u32, u8)> = Vec::new();
-        let mut found: Vec<(u32, u8)> = Vec::new();
-        let mut stencil: Vec<Run> = Vec::with_capacity(27);
+        let mut stencil: Vec<Run> = Vec::with_capacity(14);
         let mut stencil_of: Option<[i64; 3]> = None;
+        let excluding = !s.exclude_types.is_empty() || !s.exclude_groups.is_empty();
         for i in range {
             let ci = self.grid.cell_of(&p.x[i]);
             if stencil_of != Some(ci) {
@@ -312,33 +331,71 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             }
             let (xi, ri) = (p.x[i], p.radius[i]);
             // branch-free: every candidate is written, and the slot is kept
-            // when the pair is listed (the order test is a coin toss per
+            // when the pair is listed (whether it is is a coin toss per
             // candidate, so a branch on it mispredicts half the time)
             let most: usize = stencil.iter().map(|r| (r.hi - r.lo) as usize).sum();
             if buf.len() < most {
                 buf.resize(most, (0, 0));
             }
             let mut len = 0;
-            for &Run { lo, hi, img, pos } in &stencil {
-                let shift = self.images[img as usize];
+            for &Run { lo, hi, img, own } in &stencil {
+                let (shift, back) = (self.images[img as usize], self.images[opposite(img) as usize]);
                 for &j in &self.grid.items[lo as usize..hi as usize] {
                     let ju = j as usize;
-                    // each pair once, from its smaller storage index; a
-                    // particle's own periodic images once, by the positive
-                    // shift
-                    let order = (ju > i) | ((ju == i) & pos);
-                    let d = xi - (p.x[ju] + shift);
-                    let reach = ri + p.radius[ju] + s.skin + (self.extra_range)(i, ju);
+                    // the own bin's pairs once, from the smaller storage
+                    // index; the other bins' (a particle's own periodic
+                    // images among them, at the positive shifts the half
+                    // stencil reaches) all
+                    let order = !own | (ju > i);
+                    // as tested from the pair's first particle a: x[a] -
+                    // (x[b] + shift from a)
+                    let below = ju < i;
+                    let (xa, xb, sh) = if below { (p.x[ju], xi, back) } else { (xi, p.x[ju], shift) };
+                    let d = xa - (xb + sh);
+                    let extra = if below { (self.extra_range)(ju, i) } else { (self.extra_range)(i, ju) };
+                    let reach = ri + p.radius[ju] + s.skin + extra;
                     let within = d.norm_squared() < reach * reach;
                     buf[len] = (j, img);
                     len += (order & within) as usize;
                 }
             }
-            found.clear();
-            found.extend_from_slice(&buf[..len]);
-            if !s.exclude_types.is_empty() || !s.exclude_groups.is_empty() {
-                found.retain(|&(j, _)| j as usize == i || !s.excluded(p, i, j as usize));
+            for &(j, img) in &buf[..len] {
+                let ju = j as usize;
+                if excluding && ju != i && s.excluded(p, i, ju) {
+                    continue;
+                }
+                if ju >= i {
+                    out.own.push((j, img));
+                } else {
+                    out.foreign.push((j, i as u32, opposite(img)));
+                }
             }
+            out.start.push(out.own.len() as u32);
+        }
+        out
+    }
+
+    /// The list's part for the particles of `range`: each one's pairs
+    /// (found by itself, `found`, and by later particles, `foreign` from
+    /// `fstart`) in order of storage index and shift, with the history each
+    /// carries.
+    fn chunk(&self, range: std::ops::Range<usize>, found_own: &Found, fstart: &[u32], foreign: &[(u32, u8)]) -> Chunk {
+        let w = self.width;
+        // room for the pairs per particle of the last build, plus a margin
+        let room = range.len() * (self.per_particle + 2);
+        let mut out = Chunk {
+            lo: range.start,
+            count: Vec::with_capacity(range.len()),
+            b: Vec::with_capacity(room),
+            image: Vec::with_capacity(room),
+            hist: Vec::with_capacity(room * w),
+        };
+        let mut found: Vec<(u32, u8)> = Vec::new();
+        for i in range.clone() {
+            let k = i - range.start;
+            found.clear();
+            found.extend_from_slice(&found_own.own[found_own.start[k] as usize..found_own.start[k + 1] as usize]);
+            found.extend_from_slice(&foreign[fstart[i] as usize..fstart[i + 1] as usize]);
             // by storage index, then shift (periodic images of one pair)
             found.sort_unstable_by(|u, v| u.0.cmp(&v.0).then_with(|| cmp_v3(&self.images[u.1 as usize], &self.images[v.1 as usize])));
             out.count.push(found.len() as u32);
@@ -362,6 +419,30 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
         }
         out
     }
+}
+
+/// Put the pairs that chunks found by their second particle in the order
+/// of their first: CSR offsets per particle (`n + 1`) and the pairs'
+/// second particles and images, each particle's in the order found.
+fn foreign_by_first(found: &[Found], n: usize) -> (Vec<u32>, Vec<(u32, u8)>) {
+    let mut start = vec![0u32; n + 1];
+    for f in found {
+        for &(a, _, _) in &f.foreign {
+            start[a as usize + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut items = vec![(0u32, 0u8); start[n] as usize];
+    for f in found {
+        for &(a, b, img) in &f.foreign {
+            items[fill[a as usize] as usize] = (b, img);
+            fill[a as usize] += 1;
+        }
+    }
+    (start, items)
 }
 
 /// Marker bit in `PairList::adj` for "this particle is b".
@@ -600,7 +681,9 @@ impl PairList {
             let grid = Grid::new(p, dom, 2.0 * rmax + s.skin + emax);
             let per_particle = listed / self.x_built.len().max(1);
             let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width, per_particle };
-            chunks = in_chunks(n, CHUNK, |r| ctx.chunk(r));
+            let found = in_chunks(n, CHUNK, |r| ctx.find(r));
+            let (fstart, foreign) = foreign_by_first(&found, n);
+            chunks = in_chunks(n, CHUNK, |r| ctx.chunk(r.clone(), &found[r.start / CHUNK], &fstart, &foreign));
         }
         let m: usize = chunks.iter().map(|c| c.b.len()).sum();
         // the list's buffers are reused (the previous b and history too, once
@@ -1184,16 +1267,6 @@ pub fn spatial_order(p: &Particles, bin: f64) -> Vec<usize> {
     keys.into_iter().map(|(_, i)| i).collect()
 }
 
-fn positive(sh: [i64; 3]) -> bool {
-    // lexicographically positive shift: (0,0,0) is not
-    for d in (0..3).rev() {
-        if sh[d] != 0 {
-            return sh[d] > 0;
-        }
-    }
-    false
-}
-
 fn cmp_v3(a: &V3, b: &V3) -> std::cmp::Ordering {
     for d in 0..3 {
         match a[d].partial_cmp(&b[d]) {
@@ -1309,27 +1382,30 @@ impl Grid {
     fn index(&self, c: [i64; 3]) -> usize {
         ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
     }
-    /// The 27-bin stencil of bin `c` (fewer at non-periodic edges), over
-    /// dz, dy, dx = -1..=1: each bin's members, the image index of their
-    /// shift and whether that shift is lexicographically positive. Bins
-    /// whose members follow each other in `items` with the same shift (the
-    /// three along x, away from a periodic seam) make one run: a bin holds
-    /// one or two particles, and a loop per bin cost more than its tests.
+    /// The half stencil of bin `c`: the bin itself and the 13 of the
+    /// 26 around it at offsets (dz, dy, dx) lexicographically positive
+    /// (fewer at non-periodic edges). Each pair of particles and image is
+    /// then met once: from one particle at offset o, or from the other at
+    /// -o, or (o = 0, the own bin) from both. Each bin's members, the
+    /// image index of their shift and whether the bin is `c` itself. Bins
+    /// whose members follow each other in `items` with the same shift (those
+    /// along x, away from a periodic seam) make one run: a bin holds one or
+    /// two particles, and a loop per bin cost more than its tests.
     fn stencil(&self, c: [i64; 3], out: &mut Vec<Run>) {
         let (ax, ay, az) = (&self.axis[0][c[0] as usize], &self.axis[1][c[1] as usize], &self.axis[2][c[2] as usize]);
-        for &(nz, sz) in az {
-            for &(ny, sy) in ay {
-                for &(nx, sx) in ax {
-                    if nx < 0 || ny < 0 || nz < 0 {
+        for (oz, &(nz, sz)) in az.iter().enumerate() {
+            for (oy, &(ny, sy)) in ay.iter().enumerate() {
+                for (ox, &(nx, sx)) in ax.iter().enumerate() {
+                    let (own, forward) = ((oz, oy, ox) == (1, 1, 1), (oz, oy, ox) > (1, 1, 1));
+                    if nx < 0 || ny < 0 || nz < 0 || !(own || forward) {
                         continue;
                     }
                     let img = ((sx + 1) + 3 * (sy + 1) + 9 * (sz + 1)) as u8;
-                    let pos = positive([sx, sy, sz]);
                     let cell = self.index([nx, ny, nz]);
                     let (lo, hi) = (self.start[cell], self.start[cell + 1]);
                     match out.last_mut() {
-                        Some(r) if r.hi == lo && r.img == img && r.pos == pos => r.hi = hi,
-                        _ => out.push(Run { lo, hi, img, pos }),
+                        Some(r) if r.hi == lo && r.img == img && !r.own && !own => r.hi = hi,
+                        _ => out.push(Run { lo, hi, img, own }),
                     }
                 }
             }
@@ -1338,14 +1414,13 @@ impl Grid {
 }
 
 /// Stencil bins whose members follow each other in [`Grid::items`]
-/// (`lo..hi`), all seen at the image `img`; `pos`: that image's shift is
-/// lexicographically positive.
+/// (`lo..hi`), all seen at the image `img`; `own`: the particle's own bin.
 #[derive(Clone, Copy)]
 struct Run {
     lo: u32,
     hi: u32,
     img: u8,
-    pos: bool,
+    own: bool,
 }
 
 #[cfg(test)]
@@ -1356,6 +1431,19 @@ mod tests {
 
     fn part(tag: i64, x: V3, r: f64) -> NewParticle {
         NewParticle { tag, kind: 1, mask: 1, x, v: V3::zeros(), omega: V3::zeros(), radius: r, density: 1.0 }
+    }
+
+    /// Whether a shift is lexicographically positive, by z, then y, then x
+    /// ((0, 0, 0) is not): the images of a particle with itself that the
+    /// list keeps (the half stencil's offsets, which for a particle and
+    /// itself are its shifts).
+    fn positive(sh: [i64; 3]) -> bool {
+        for d in (0..3).rev() {
+            if sh[d] != 0 {
+                return sh[d] > 0;
+            }
+        }
+        false
     }
 
     /// Brute-force all (i, j, image) pairs within reach.
