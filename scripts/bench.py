@@ -298,6 +298,13 @@ def write(a, rows, scaling):
         lines += ["", f"demx's two threads against its one, interleaved in one loop ({a.reps} rounds of one run each, "
                   f"one thread then two): {own['two']:.3e} against {own['one']:.3e} particle-steps/s, per-round ratio "
                   f"{own['ratio']:.2f} (median); the two table rows above come from runs minutes apart."]
+        two = next((r["demx"] for r in rows if r["name"].startswith("(a) bed, 2 threads")), None)
+        if one and two and abs((two / one) / own["ratio"] - 1) > 0.15:
+            # the rows' ratio far from the loop's: a run lost its second
+            # core (on a shared machine another tenant takes it at times)
+            lines += ["", f"**Disturbed run:** the table's two (a) rows give {two / one:.2f}x for two threads against one, "
+                      f"the loop above {own['ratio']:.2f}x; a run of one of them lost a core to the machine. Read the "
+                      "loop's ratio, and run the bench again for the table."]
     lines += ["", "Where the time goes (the median run's section timing, as each program prints it):", "",
               "| case | demx | engine |", "| --- | --- | --- |"]
     for r in rows:
