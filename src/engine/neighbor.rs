@@ -376,9 +376,9 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
     }
 
     /// The list's part for the particles of `range`: each one's pairs
-    /// (found by itself, `found`, and by later particles, `foreign` from
-    /// `fstart`) in order of storage index and shift, with the history each
-    /// carries.
+    /// (those it found itself, in `found_own`, and those later particles
+    /// found, in `foreign` from `fstart`) in order of storage index and
+    /// shift, with the history each carries.
     fn chunk(&self, range: std::ops::Range<usize>, found_own: &Found, fstart: &[u32], foreign: &[(u32, u8)]) -> Chunk {
         let w = self.width;
         // room for the pairs per particle of the last build, plus a margin
