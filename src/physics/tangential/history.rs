@@ -3,7 +3,7 @@
 //!
 //! xi += v_t dt; xi -= (xi . n) n (projection, no magnitude rescale);
 //! F_el = -k_t xi; if k_t |xi| > mu |F_n|: F_t = F_el mu |F_n| / (k_t |xi|),
-//! xi = -F_t / k_t, and no damping while sliding; else
+//! xi = -F_t / k_t (computed as xi mu |F_n| / (k_t |xi|)), and no damping while sliding; else
 //! F_t = F_el - gamma_t v_t. Relative velocity and torque use the
 //! contact-point distance R - delta/2 of each sphere (`surface_model_default.h`).
 
@@ -42,10 +42,14 @@ impl TangentialLaw for LiggghtsHistory {
         // it, no damping; sticking: elastic plus damping
         let slide = ft_shear.gt(ft_friction);
         let moved = shrmag.ne(R::splat(0.0));
-        let ft_slide = ft_el * (ft_friction / ft_shear);
+        let ratio = ft_friction / ft_shear;
+        let ft_slide = ft_el * ratio;
         let ft_stick = ft_el - vtr * out.gamma_t;
         let ft = Vec3::select(slide, Vec3::select(moved, ft_slide, Vec3::zeros()), ft_stick);
-        xi = Vec3::select(slide.and(moved), -ft_slide / k_t, xi);
+        // the spring reset to the cap, xi = -F_t / k_t = xi mu |F_n| / (k_t |xi|):
+        // one multiply by the ratio, not three divisions by k_t (the
+        // divider is the batch's scarcest unit; the two differ by rounding)
+        xi = Vec3::select(slide.and(moved), xi * ratio, xi);
         put3_lanes(hist, &xi);
         out.ft = ft;
         add_tangential_torque_lanes(c, &ft, cri, crj, out);
