@@ -160,6 +160,12 @@ def engine_cmd(engine, deck, ranks, var):
     return cmd
 
 
+# The spread of a program's repetitions (fastest over slowest) above which
+# a row is flagged: runs of one binary on a quiet machine stay within a few
+# percent of each other.
+UNSTEADY = 1.15
+
+
 def case(name, deck, engine, var, reps, threads=1, ranks=1, engine_deck=None, cwd=WORK):
     """Interleaved runs of demx and the engine; medians."""
     d_ps, e_ps, d_rss, e_rss, d_sec, e_sec = [], [], [], [], [], []
@@ -171,7 +177,9 @@ def case(name, deck, engine, var, reps, threads=1, ranks=1, engine_deck=None, cw
             e_ps.append(rate(out)[0]); e_rss.append(rss); e_sec.append(sections(out, engine))
     md = statistics.median(d_ps)
     me = statistics.median(e_ps) if e_ps else None
+    spread = lambda v: max(v) / min(v) if v and min(v) > 0 else None
     row = dict(name=name, demx=md, engine=me, eng=engine, ranks=ranks, threads=threads, drss=max(d_rss),
+               dspread=spread(d_ps), espread=spread(e_ps),
                erss=max(e_rss) if e_rss else None, dsec=d_sec[len(d_sec) // 2], esec=e_sec[len(e_sec) // 2] if e_sec else None,
                atoms=loops(out)[-1][2] if loops(out) else 0)
     ratio = f", ratio {md / me:.2f}" if me else ""
@@ -288,6 +296,20 @@ def write(a, rows, scaling):
         ratio = f"{r['demx'] / r['engine']:.2f}" if r["engine"] else "-"
         rss = f"{r['drss'] / 1024:.0f} / {r['erss'] / 1024:.0f}" if r["erss"] else f"{r['drss'] / 1024:.0f}"
         lines.append(f"| {r['name']} (demx --threads {r['threads']}) | {r['atoms']:,} | {r['demx']:.3e} | {eng} | {ratio} | {rss} |")
+    # a median hides one slow repetition, not a machine that slowed for the
+    # whole case: the spread of each program's repetitions says which rows
+    # ran on a steady machine
+    spreads = [(r, k, r[k]) for r in rows for k in ("dspread", "espread") if r.get(k)]
+    if spreads:
+        lines += ["", "Spread of the repetitions (fastest over slowest, each program): " + "; ".join(
+            f"{r['name'].split(',')[0]} demx {r['dspread']:.2f}" + (f", {r['eng']} {r['espread']:.2f}" if r.get("espread") else "")
+            for r in rows if r.get("dspread")) + "."]
+        unsteady = [(r, k, v) for r, k, v in spreads if v > UNSTEADY]
+        if unsteady:
+            lines += ["", "**Unsteady rows:** " + "; ".join(
+                f"{r['name'].split(',')[0]} {'demx' if k == 'dspread' else r['eng']} ({v:.2f})" for r, k, v in unsteady) +
+                f": one program's repetitions differ by more than {100 * (UNSTEADY - 1):.0f}%, so the machine's speed moved "
+                "during the case. Their ratios are not to be trusted; run the case again (`--only`)."]
     one = next((r["demx"] for r in rows if r["name"].startswith("(a) settled bed")), None)
     if CEILING.get("both") and one:
         lines += ["", f"What two cores give this machine: two one-thread demx runs of (a) at once (separate processes) ran at "
