@@ -299,17 +299,19 @@ def write(a, rows, scaling):
     # a median hides one slow repetition, not a machine that slowed for the
     # whole case: the spread of each program's repetitions says which rows
     # ran on a steady machine
-    spreads = [(r, k, r[k]) for r in rows for k in ("dspread", "espread") if r.get(k)]
+    named = rows + [dict(r, name=f"(e) {r['n']} spheres") for r in scaling]
+    spreads = [(r, k, r[k]) for r in named for k in ("dspread", "espread") if r.get(k)]
     if spreads:
         lines += ["", "Spread of the repetitions (fastest over slowest, each program): " + "; ".join(
             f"{r['name'].split(',')[0]} demx {r['dspread']:.2f}" + (f", {r['eng']} {r['espread']:.2f}" if r.get("espread") else "")
-            for r in rows if r.get("dspread")) + "."]
+            for r in named if r.get("dspread")) + "."]
         unsteady = [(r, k, v) for r, k, v in spreads if v > UNSTEADY]
         if unsteady:
             lines += ["", "**Unsteady rows:** " + "; ".join(
                 f"{r['name'].split(',')[0]} {'demx' if k == 'dspread' else r['eng']} ({v:.2f})" for r, k, v in unsteady) +
                 f": one program's repetitions differ by more than {100 * (UNSTEADY - 1):.0f}%, so the machine's speed moved "
-                "during the case. Their ratios are not to be trusted; run the case again (`--only`)."]
+                "during the case. Their figures are not to be trusted; run the bench again (`--only` writes a table of the cases it runs "
+                "alone)."]
     one = next((r["demx"] for r in rows if r["name"].startswith("(a) settled bed")), None)
     if CEILING.get("both") and one:
         lines += ["", f"What two cores give this machine: two one-thread demx runs of (a) at once (separate processes) ran at "
