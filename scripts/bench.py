@@ -296,9 +296,9 @@ def write(a, rows, scaling):
         ratio = f"{r['demx'] / r['engine']:.2f}" if r["engine"] else "-"
         rss = f"{r['drss'] / 1024:.0f} / {r['erss'] / 1024:.0f}" if r["erss"] else f"{r['drss'] / 1024:.0f}"
         lines.append(f"| {r['name']} (demx --threads {r['threads']}) | {r['atoms']:,} | {r['demx']:.3e} | {eng} | {ratio} | {rss} |")
-    # a median hides one slow repetition, not a machine that slowed for the
-    # whole case: the spread of each program's repetitions says which rows
-    # ran on a steady machine
+    # a median hides a slow repetition: the spread of each program's
+    # repetitions shows whether the machine's speed moved during a case (a
+    # machine slow for a whole case shows only against earlier tables)
     named = rows + [dict(r, name=f"(e) {r['n']} spheres") for r in scaling]
     spreads = [(r, k, r[k]) for r in named for k in ("dspread", "espread") if r.get(k)]
     if spreads:
