@@ -300,15 +300,16 @@ def write(a, rows, scaling):
     # repetitions shows whether the machine's speed moved during a case (a
     # machine slow for a whole case shows only against earlier tables)
     named = rows + [dict(r, name=f"(e) {r['n']} spheres") for r in scaling]
+    label = lambda r: r["name"].split(",")[0]
     spreads = [(r, k, r[k]) for r in named for k in ("dspread", "espread") if r.get(k)]
     if spreads:
         lines += ["", "Spread of the repetitions (fastest over slowest, each program): " + "; ".join(
-            f"{r['name'].split(',')[0]} demx {r['dspread']:.2f}" + (f", {r['eng']} {r['espread']:.2f}" if r.get("espread") else "")
+            f"{label(r)} demx {r['dspread']:.2f}" + (f", {r['eng']} {r['espread']:.2f}" if r.get("espread") else "")
             for r in named if r.get("dspread")) + "."]
         unsteady = [(r, k, v) for r, k, v in spreads if v > UNSTEADY]
         if unsteady:
             lines += ["", "**Unsteady rows:** " + "; ".join(
-                f"{r['name'].split(',')[0]} {'demx' if k == 'dspread' else r['eng']} ({v:.2f})" for r, k, v in unsteady) +
+                f"{label(r)} {'demx' if k == 'dspread' else r['eng']} ({v:.2f})" for r, k, v in unsteady) +
                 f": one program's repetitions differ by more than {100 * (UNSTEADY - 1):.0f}%, so the machine's speed moved "
                 "during the case. Their figures are not to be trusted; run the bench again (`--only` writes a table of the cases it runs "
                 "alone)."]
