@@ -40,5 +40,8 @@ for line in text.splitlines():
     if m:
         print(f"force pass blocks (inclusive): {int(m.group(1).replace(',', '')) / ps:.0f} instructions per particle-step")
         break
+else:
+    # the block closure's symbol is the compiler's name for it, and may change
+    print("force pass: its closure's symbol was not found; read target/v3/callgrind.txt")
 EOF
 echo "per source line: target/v3/callgrind.txt"
