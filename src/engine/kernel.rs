@@ -484,6 +484,8 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             tq.fill(V3::zeros());
             let xs = &xslot[block_cross[q] as usize..];
             let blk = Block { p, a, b, image, images, xs, table, dt, lo: q * bs, ps, pe, dense: dense_only };
+            // the batches index without bounds checks what this bounds
+            assert!(blk.bounded(f, tq, h, lv, w), "pair list not built for these particles");
             self.block_batched(&blk, h, d, lv, f, tq)
         };
         let lanes = Self::BATCHED && !self.scalar_only();
@@ -667,15 +669,46 @@ fn prefetch_ahead(k: &Block<'_>, h: &[f64], q: usize, w: usize) {
 /// if it came apart. Few pairs come apart in a step, so the branch is
 /// foreseen (unlike whether a pair touches); a pass over the block's flags
 /// after the walk to find them cost the chute 3% of its run.
+///
+/// # Safety
+/// `q < lv.len()` and `(q + 1) * w <= h.len()` ([`Block::bounded`]).
 #[inline(always)]
-fn came_apart(h: &mut [f64], lv: &mut [u8], q: usize, w: usize, apart: bool) {
+unsafe fn came_apart(h: &mut [f64], lv: &mut [u8], q: usize, w: usize, apart: bool) {
     // one branch on both (as integers: on bools the compiler tests `apart`
     // first, the coin toss)
-    let was = lv[q];
-    lv[q] = (!apart) as u8;
-    if was > lv[q] {
-        h[q * w..(q + 1) * w].fill(0.0);
+    // SAFETY: the caller's
+    let flag = unsafe { at_mut(lv, q) };
+    let was = *flag;
+    *flag = (!apart) as u8;
+    if was > *flag {
+        for m in 0..w {
+            // SAFETY: the caller's
+            unsafe { *at_mut(h, q * w + m) = 0.0 };
+        }
     }
+}
+
+/// `s[k]`, its bounds check left out: for the batched pass's indices,
+/// which [`Block::bounded`] checked for the whole block before its pass.
+///
+/// # Safety
+/// `k < s.len()`.
+#[inline(always)]
+unsafe fn at<T: Copy>(s: &[T], k: usize) -> T {
+    debug_assert!(k < s.len());
+    // SAFETY: the caller's
+    unsafe { *s.get_unchecked(k) }
+}
+
+/// `&mut s[k]`, as [`at`].
+///
+/// # Safety
+/// `k < s.len()`.
+#[inline(always)]
+unsafe fn at_mut<T>(s: &mut [T], k: usize) -> &mut T {
+    debug_assert!(k < s.len());
+    // SAFETY: the caller's
+    unsafe { s.get_unchecked_mut(k) }
 }
 
 /// What a block of the batched pass reads.
@@ -696,6 +729,31 @@ struct Block<'a> {
     pe: usize,
     /// Run it in batches of consecutive pairs however few touch (tests).
     dense: bool,
+}
+
+impl Block<'_> {
+    /// Whether every index the block's batches read without a bounds check
+    /// ([`at`]) is in bounds: the particles' arrays of one length `n`, each
+    /// pair's first particle among the block's (whose forces and torques `f`
+    /// and `tq` hold), its second below `n`, its image in `images`, and a
+    /// live flag in `lv` and `w` history values in `h` for each pair. A list
+    /// built for these particles always is; a fold without an early exit,
+    /// one pass over the block's indices.
+    fn bounded(&self, f: &[V3], tq: &[V3], h: &[f64], lv: &[u8], w: usize) -> bool {
+        let p = self.p;
+        let n = p.x.len();
+        let same = [p.v.len(), p.omega.len(), p.radius.len(), p.mass.len(), p.kind.len(), p.frozen.len()].iter().all(|&l| l == n);
+        let (lo, nf, ni) = (self.lo, f.len(), self.images.len());
+        let range = self.ps <= self.pe && self.pe <= self.a.len() && self.pe <= self.b.len() && self.pe <= self.image.len();
+        let np = self.pe.saturating_sub(self.ps);
+        if !(same && range && lo + nf <= n && tq.len() == nf && h.len() == np * w && lv.len() == np) {
+            return false;
+        }
+        let a = self.a[self.ps..self.pe].iter().fold(true, |ok, &i| ok & ((i as usize).wrapping_sub(lo) < nf));
+        let b = self.b[self.ps..self.pe].iter().fold(true, |ok, &j| ok & ((j as usize) < n));
+        let im = self.image[self.ps..self.pe].iter().fold(true, |ok, &c| ok & ((c as usize) < ni));
+        a & b & im
+    }
 }
 
 super::switch::switch!(
@@ -820,7 +878,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             slots[queued] = slot;
             slot += (j.wrapping_sub(lo) >= len) as usize;
             queued += touch as usize;
-            came_apart(h, lv, q, w, apart);
+            // SAFETY: q < pe - ps, the block's pairs ([`Block::bounded`])
+            unsafe { came_apart(h, lv, q, w, apart) };
             if queued == LANES {
                 self.run_batch::<false>(k, &mut lanes, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
                 queued = 0;
@@ -866,27 +925,35 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             v.y.0[l] = x.y;
             v.z.0[l] = x.z;
         };
+        debug_assert!((1..=LANES).contains(&count));
+        let last = count.clamp(1, LANES) - 1;
+        // SAFETY (each `at` below): a queued pair lies among the block's
+        // pairs, whose particles, images and history `Block::bounded`
+        // bounded before the pass
+        let mass = |k: usize| unsafe { if p.any_frozen && at(p.frozen, k) { f64::INFINITY } else { at(p.mass, k) } };
         for l in 0..LANES {
-            let pk = queue[l.min(count - 1)];
-            let (i, j) = (k.a[pk] as usize, k.b[pk] as usize);
-            put(&mut s.xi, l, &p.x[i]);
-            put(&mut s.xj, l, &(p.x[j] + k.images[k.image[pk] as usize]));
-            put(&mut s.vi, l, &p.v[i]);
-            put(&mut s.vj, l, &p.v[j]);
-            put(&mut s.wi, l, &p.omega[i]);
-            put(&mut s.wj, l, &p.omega[j]);
-            s.ri.0[l] = p.radius[i];
-            s.rj.0[l] = p.radius[j];
-            s.mi.0[l] = contact_mass(p, i);
-            s.mj.0[l] = contact_mass(p, j);
+            let pk = queue[l.min(last)];
+            let (i, j, img) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize, at(k.image, pk) as usize) };
+            unsafe {
+                put(&mut s.xi, l, &at(p.x, i));
+                put(&mut s.xj, l, &(at(p.x, j) + at(k.images, img)));
+                put(&mut s.vi, l, &at(p.v, i));
+                put(&mut s.vj, l, &at(p.v, j));
+                put(&mut s.wi, l, &at(p.omega, i));
+                put(&mut s.wj, l, &at(p.omega, j));
+                s.ri.0[l] = at(p.radius, i);
+                s.rj.0[l] = at(p.radius, j);
+            }
+            s.mi.0[l] = mass(i);
+            s.mj.0[l] = mass(j);
             if !one_type {
-                let pp = k.table.get(p.kind[i], p.kind[j]);
+                let pp = unsafe { k.table.get(at(p.kind, i), at(p.kind, j)) };
                 coeffs.uniform &= std::ptr::eq(pp, p0);
                 coeffs.p[l] = pp;
             }
-            let hk = &h[(pk - k.ps) * w..(pk - k.ps + 1) * w];
-            for (m, v) in hk.iter().enumerate() {
-                hist[m].0[l] = *v;
+            let h0 = (pk - k.ps) * w;
+            for (m, v) in hist[..w].iter_mut().enumerate() {
+                v.0[l] = unsafe { at(h, h0 + m) };
             }
         }
         // which lanes touch, as the walk decides it (the same operations:
@@ -902,39 +969,46 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             for l in 0..count {
                 let apart = r2.0[l] >= rr.0[l];
                 touch[l] = !apart & (r2.0[l] != 0.0);
-                came_apart(h, lv, queue[l] - k.ps, w, apart);
+                // SAFETY: queued pairs are the block's ([`Block::bounded`])
+                unsafe { came_apart(h, lv, queue[l] - k.ps, w, apart) };
             }
         }
         let c = contact_lanes(s, k.dt);
         let o = self.apply_lanes(&c, &coeffs, &mut hist[..w]);
         let fi = o.force_i(&c);
         let vir = (s.xi - s.xj).dot(&fi);
-        for l in 0..count {
+        for l in 0..count.min(LANES) {
             if DENSE && !touch[l] {
                 continue;
             }
             let pk = queue[l];
-            let (i, j) = (k.a[pk] as usize, k.b[pk] as usize);
-            let hk = &mut h[(pk - k.ps) * w..(pk - k.ps + 1) * w];
+            let q = pk - k.ps;
+            // SAFETY (each `at` and `at_mut` below): as the gather's; `i` is
+            // the block's, `j` is where the branch says
+            let (i, j) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize) };
             let delta = c.delta.0[l];
             let beyond = if C::NONCONTACT { delta <= -coeffs.p[l].extra_range } else { delta <= 0.0 };
             if beyond {
                 // within reach by r^2 but not by the overlap (rounding): apart,
                 // as the per-contact pass decides
-                hk.fill(0.0);
-                lv[pk - k.ps] = 0;
+                h[q * w..(q + 1) * w].fill(0.0);
+                lv[q] = 0;
                 continue;
             }
-            for (m, v) in hk.iter_mut().enumerate() {
-                *v = hist[m].0[l];
+            for (m, v) in hist[..w].iter().enumerate() {
+                unsafe { *at_mut(h, q * w + m) = v.0[l] };
             }
             let fl = fi.lane(l);
             *virial += vir.0[l];
-            f[i - k.lo] += fl;
-            tq[i - k.lo] += o.torque_i.lane(l);
+            unsafe {
+                *at_mut(f, i - k.lo) += fl;
+                *at_mut(tq, i - k.lo) += o.torque_i.lane(l);
+            }
             if j.wrapping_sub(k.lo) < f.len() {
-                f[j - k.lo] -= fl;
-                tq[j - k.lo] += o.torque_j.lane(l);
+                unsafe {
+                    *at_mut(f, j - k.lo) -= fl;
+                    *at_mut(tq, j - k.lo) += o.torque_j.lane(l);
+                }
             } else {
                 d[k.xs[slots[l]] as usize] = [fl, o.torque_j.lane(l)];
             }
