@@ -977,6 +977,11 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let o = self.apply_lanes(&c, &coeffs, &mut hist[..w]);
         let fi = o.force_i(&c);
         let vir = (s.xi - s.xj).dot(&fi);
+        // what the lanes below read, lane by lane, taken out of the contact
+        // and the laws' output, which then need not be kept in memory (a
+        // lane read at a varying index pins the whole struct there: each
+        // batch copied both)
+        let (delta, ti, tj) = (c.delta, o.torque_i, o.torque_j);
         for l in 0..count.min(LANES) {
             if DENSE && !touch[l] {
                 continue;
@@ -986,7 +991,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             // SAFETY (each `at` and `at_mut` below): as the gather's; `i` is
             // the block's, `j` is where the branch says
             let (i, j) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize) };
-            let delta = c.delta.0[l];
+            let delta = delta.0[l];
             let beyond = if C::NONCONTACT { delta <= -coeffs.p[l].extra_range } else { delta <= 0.0 };
             if beyond {
                 // within reach by r^2 but not by the overlap (rounding): apart,
@@ -1002,15 +1007,15 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             *virial += vir.0[l];
             unsafe {
                 *at_mut(f, i - k.lo) += fl;
-                *at_mut(tq, i - k.lo) += o.torque_i.lane(l);
+                *at_mut(tq, i - k.lo) += ti.lane(l);
             }
             if j.wrapping_sub(k.lo) < f.len() {
                 unsafe {
                     *at_mut(f, j - k.lo) -= fl;
-                    *at_mut(tq, j - k.lo) += o.torque_j.lane(l);
+                    *at_mut(tq, j - k.lo) += tj.lane(l);
                 }
             } else {
-                d[k.xs[slots[l]] as usize] = [fl, o.torque_j.lane(l)];
+                d[k.xs[slots[l]] as usize] = [fl, tj.lane(l)];
             }
         }
     }
@@ -1196,6 +1201,41 @@ mod tests {
         });
         let panicked = rx.recv_timeout(std::time::Duration::from_secs(60)).expect("the fused pass hung after a block panicked");
         assert!(panicked, "the block's panic did not reach the caller");
+    }
+
+    /// The check behind the batches' unchecked indexing: a block of a list
+    /// built for the particles is bounded; one whose particles are fewer than
+    /// the list's, or whose pair, image or history is out of range, is not.
+    #[test]
+    fn a_block_is_bounded_only_for_the_particles_its_list_was_built_for() {
+        let (dom, p, table, laws) = spring_gas();
+        let mut pl = PairList { block: 64, ..Default::default() };
+        pl.build(&p, &dom, &NeighSettings { skin: 0.05, ..Default::default() }, 0, &laws.history_signs(), |_, _| 0.0);
+        let w = 1;
+        let (ps, pe) = (pl.block_start[1] as usize, pl.block_start[2] as usize);
+        assert!(pe > ps, "block 1 has pairs");
+        let (f, h, lv) = (vec![V3::zeros(); 64], vec![0.0; (pe - ps) * w], vec![0u8; pe - ps]);
+        let bounded = |state: &PassState<'_>, b: &[u32], image: &[u8], f: &[V3], h: &[f64]| {
+            let k = Block { p: state, a: &pl.a, b, image, images: &pl.images, xs: &[], table: &table, dt: 1e-3, lo: 64, ps, pe, dense: false };
+            k.bounded(f, f, h, &lv, w)
+        };
+        let whole = PassState::of(&p);
+        assert!(bounded(&whole, &pl.b, &pl.image, &f, &h));
+        // the last particle, a partner of block 1, gone
+        let far = pl.b[ps..pe].iter().copied().max().unwrap() as usize;
+        let n = far;
+        let fewer = PassState { x: &p.x[..n], v: &p.v[..n], omega: &p.omega[..n], radius: &p.radius[..n], mass: &p.mass[..n], kind: &p.kind[..n], frozen: &p.frozen[..n], any_frozen: false };
+        assert!(!bounded(&fewer, &pl.b, &pl.image, &f, &h));
+        let mut b = pl.b.clone();
+        b[pe - 1] = p.len() as u32;
+        assert!(!bounded(&whole, &b, &pl.image, &f, &h));
+        let mut image = pl.image.clone();
+        image[ps] = pl.images.len() as u8;
+        assert!(!bounded(&whole, &pl.b, &image, &f, &h));
+        // one force slot fewer than the block's last first particle needs
+        let top = pl.a[ps..pe].iter().copied().max().unwrap() as usize - 64;
+        assert!(!bounded(&whole, &pl.b, &pl.image, &f[..top], &h));
+        assert!(!bounded(&whole, &pl.b, &pl.image, &f, &h[1..]));
     }
 
     #[test]
