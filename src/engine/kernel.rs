@@ -711,6 +711,58 @@ unsafe fn at_mut<T>(s: &mut [T], k: usize) -> &mut T {
     unsafe { s.get_unchecked_mut(k) }
 }
 
+/// `SPREAD[b]` has byte `l` set to bit `l` of `b`: eight lanes' flags, as
+/// eight live flags.
+const SPREAD: [u64; 256] = {
+    let mut t = [0u64; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut l = 0;
+        while l < 8 {
+            t[b] |= ((b as u64 >> l) & 1) << (8 * l);
+            l += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// [`came_apart`] for the `count` consecutive pairs from `q0` of a dense
+/// batch, lane `l`'s pair apart where bit `l` of `apart` is set: a full
+/// batch's eight flags are read and written as one word, and the history of
+/// those that came apart (rare) cleared one by one.
+///
+/// # Safety
+/// `q0 + count <= lv.len()`, `(q0 + count) * w <= h.len()` and
+/// `count <= LANES`.
+#[inline(always)]
+unsafe fn batch_came_apart(h: &mut [f64], lv: &mut [u8], q0: usize, count: usize, w: usize, apart: u32) {
+    debug_assert!(q0 + count <= lv.len() && (q0 + count) * w <= h.len() && count <= LANES);
+    if count < LANES {
+        for l in 0..count {
+            // SAFETY: the caller's
+            unsafe { came_apart(h, lv, q0 + l, w, apart >> l & 1 != 0) };
+        }
+        return;
+    }
+    // SAFETY: the caller's: the eight flags from q0 are the block's
+    let flags = unsafe { lv.get_unchecked_mut(q0..q0 + LANES) };
+    let was = u64::from_le_bytes(<[u8; 8]>::try_from(&*flags).unwrap_or_default());
+    let now = SPREAD[(!apart & 0xff) as usize];
+    flags.copy_from_slice(&now.to_le_bytes());
+    // flags are 0 or 1: a byte of `gone` is 1 where the pair was live and
+    // is now apart
+    let mut gone = was & !now;
+    while gone != 0 {
+        let l = gone.trailing_zeros() as usize / 8;
+        for m in 0..w {
+            // SAFETY: the caller's
+            unsafe { *at_mut(h, (q0 + l) * w + m) = 0.0 };
+        }
+        gone &= gone - 1;
+    }
+}
+
 /// What a block of the batched pass reads.
 struct Block<'a> {
     p: &'a PassState<'a>,
@@ -958,7 +1010,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         }
         // which lanes touch, as the walk decides it (the same operations:
         // r^2 summed x + y + z, the reach ri + rj plus the extra range)
-        let mut touch = [true; LANES];
+        // the lanes whose forces are added, as bits: every queued one, or in
+        // a dense batch those that touch
+        let mut touch = u32::MAX;
         if DENSE {
             let r2 = (s.xi - s.xj).norm_squared();
             let mut reach = s.ri + s.rj;
@@ -966,12 +1020,11 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 reach += F8(std::array::from_fn(|l| coeffs.p[l].extra_range));
             }
             let rr = reach * reach;
-            for l in 0..count {
-                let apart = r2.0[l] >= rr.0[l];
-                touch[l] = !apart & (r2.0[l] != 0.0);
-                // SAFETY: queued pairs are the block's ([`Block::bounded`])
-                unsafe { came_apart(h, lv, queue[l] - k.ps, w, apart) };
-            }
+            let apart = r2.ge(rr).bits() & ((1u32 << last) << 1).wrapping_sub(1);
+            touch = !apart & r2.ne(F8::splat(0.0)).bits();
+            // SAFETY: a dense batch's pairs are consecutive from queue[0],
+            // the block's ([`Block::bounded`])
+            unsafe { batch_came_apart(h, lv, queue[0] - k.ps, last + 1, w, apart) };
         }
         let c = contact_lanes(s, k.dt);
         let o = self.apply_lanes(&c, &coeffs, &mut hist[..w]);
@@ -983,7 +1036,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // batch copied both)
         let (delta, ti, tj) = (c.delta, o.torque_i, o.torque_j);
         for l in 0..count.min(LANES) {
-            if DENSE && !touch[l] {
+            if DENSE && touch >> l & 1 == 0 {
                 continue;
             }
             let pk = queue[l];

@@ -156,6 +156,28 @@ impl Mask for M8 {
     }
 }
 
+impl M8 {
+    /// The lanes as bits, lane `l` at bit `l`.
+    #[inline(always)]
+    pub fn bits(self) -> u32 {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        return wide::bits(self);
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        return self.0.iter().enumerate().fold(0, |b, (l, &m)| b | (m as u32) << l);
+    }
+}
+
+impl F8 {
+    /// `self >= o` per lane (false where either is NaN, as Rust's `>=`).
+    #[inline(always)]
+    pub fn ge(self, o: F8) -> M8 {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        return wide::ge(self, o);
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        return cmp(self.0, o.0, |a, b| a >= b);
+    }
+}
+
 /// `F8` as two AVX2 registers. Left to vectorise the lane loops of the
 /// portable form, the compiler split a batch's arithmetic into pieces of
 /// one, two and four lanes and spilled between them: the laws of deck (a)
@@ -234,6 +256,7 @@ mod wide {
     compare!(lt, _CMP_LT_OQ);
     compare!(ne, _CMP_NEQ_UQ);
     compare!(equal, _CMP_EQ_OQ);
+    compare!(ge, _CMP_GE_OQ);
     #[inline(always)]
     pub(super) fn and(a: M8, b: M8) -> M8 {
         // SAFETY: as in `halves`
@@ -243,6 +266,11 @@ mod wide {
     pub(super) fn any(m: M8) -> bool {
         // SAFETY: as in `halves`
         unsafe { (_mm256_movemask_pd(m.0[0]) | _mm256_movemask_pd(m.0[1])) != 0 }
+    }
+    #[inline(always)]
+    pub(super) fn bits(m: M8) -> u32 {
+        // SAFETY: as in `halves`
+        unsafe { (_mm256_movemask_pd(m.0[0]) | _mm256_movemask_pd(m.0[1]) << 4) as u32 }
     }
     #[inline(always)]
     pub(super) fn select(m: M8, a: F8, b: F8) -> F8 {
@@ -577,8 +605,9 @@ mod tests {
                         checked += 1;
                     }
                 }
-                let masks: [(&str, M8, fn(f64, f64) -> bool); 5] = [
+                let masks: [(&str, M8, fn(f64, f64) -> bool); 6] = [
                     ("gt", a.gt(b), |x, y| x > y),
+                    ("ge", a.ge(b), |x, y| x >= y),
                     ("lt", a.lt(b), |x, y| x < y),
                     ("ne", a.ne(b), |x, y| x != y),
                     ("equal", a.equal(b), |x, y| x == y),
@@ -590,6 +619,7 @@ mod tests {
                         assert_eq!(picked.0[l] == 1.0, want(x, ys[l]), "{name}({x:e}, {:e}) lane {l}", ys[l]);
                     }
                     assert_eq!(m.any(), (0..LANES).any(|l| want(x, ys[l])), "{name} any");
+                    assert_eq!(m.bits(), (0..LANES).fold(0, |b, l| b | (want(x, ys[l]) as u32) << l), "{name} bits");
                     assert_eq!(m.and(b.gt(F8::splat(0.0))).any(), (0..LANES).any(|l| want(x, ys[l]) && ys[l] > 0.0), "{name} and");
                 }
             }
