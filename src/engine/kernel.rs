@@ -866,9 +866,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     #[inline(always)]
     fn block_dense(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
         let w = Self::WIDTH;
-        let (lo, len) = (k.lo, f.len());
-        let mut queue = [0usize; LANES];
-        let mut slots = [0usize; LANES];
+        // a dense batch's pairs are consecutive: no queue, and their cross
+        // slots are counted by the batch
+        let none = [0usize; LANES];
         let mut slot = 0;
         let mut lanes = BatchLanes::new();
         let mut virial = 0.0;
@@ -877,13 +877,10 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         while q0 < n {
             let count = (n - q0).min(LANES);
             for l in 0..count {
-                let q = q0 + l;
-                prefetch_ahead(k, h, q, w);
-                queue[l] = k.ps + q;
-                slots[l] = slot;
-                slot += ((k.b[k.ps + q] as usize).wrapping_sub(lo) >= len) as usize;
+                prefetch_ahead(k, h, q0 + l, w);
             }
-            self.run_batch::<true>(k, &mut lanes, &queue, &slots, count, h, d, lv, f, tq, &mut virial);
+            let dense = Dense { first: k.ps + q0, slot: &mut slot };
+            self.run_batch::<true>(k, &mut lanes, &none, &none, dense, count, h, d, lv, f, tq, &mut virial);
             q0 += count;
         }
         virial
@@ -933,12 +930,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             // SAFETY: q < pe - ps, the block's pairs ([`Block::bounded`])
             unsafe { came_apart(h, lv, q, w, apart) };
             if queued == LANES {
-                self.run_batch::<false>(k, &mut lanes, &queue, &slots, LANES, h, d, lv, f, tq, &mut virial);
+                self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, LANES, h, d, lv, f, tq, &mut virial);
                 queued = 0;
             }
         }
         if queued > 0 {
-            self.run_batch::<false>(k, &mut lanes, &queue, &slots, queued, h, d, lv, f, tq, &mut virial);
+            self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, queued, h, d, lv, f, tq, &mut virial);
         }
         virial
     }
@@ -946,8 +943,10 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// Gather `count` queued pairs into lanes (the rest repeat the last one
     /// and are dropped), run the laws, write history back and add forces in
     /// queue order, and the lanes' virial to `virial`, in queue order.
-    /// `DENSE`: the pairs were not sorted out by the walk; the batch sets
-    /// their live flags and keeps the touching lanes alone.
+    /// `DENSE`: the pairs, the `count` from `dense.first`, were not sorted
+    /// out by the walk; the batch sets their live flags, keeps the touching
+    /// lanes alone, and counts their cross slots on from `dense.slot`
+    /// (`queue` and `slots` unread).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn run_batch<const DENSE: bool>(
@@ -956,6 +955,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         lanes: &mut BatchLanes,
         queue: &[usize; LANES],
         slots: &[usize; LANES],
+        dense: Dense<'_>,
         count: usize,
         h: &mut [f64],
         d: &mut [[V3; 2]],
@@ -970,22 +970,26 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let one_type = k.table.ntypes == 1;
         // with one type, types are not read (as in the walk): each batch's
         // first partner's type was a line from memory on a large bed
-        let p0 = if one_type { k.table.get(1, 1) } else { k.table.get(p.kind[k.a[queue[0]] as usize], p.kind[k.b[queue[0]] as usize]) };
+        debug_assert!((1..=LANES).contains(&count));
+        let last = count.clamp(1, LANES) - 1;
+        let Dense { first, slot } = dense;
+        let pair = |l: usize| if DENSE { first + l.min(last) } else { queue[l.min(last)] };
+        let p0 = if one_type { k.table.get(1, 1) } else { k.table.get(p.kind[k.a[pair(0)] as usize], p.kind[k.b[pair(0)] as usize]) };
         let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
         let put = |v: &mut Vec3<F8>, l: usize, x: &V3| {
             v.x.0[l] = x.x;
             v.y.0[l] = x.y;
             v.z.0[l] = x.z;
         };
-        debug_assert!((1..=LANES).contains(&count));
-        let last = count.clamp(1, LANES) - 1;
+        // the lanes whose pair's second particle is in a later block (dense)
+        let mut cross = 0u32;
         // SAFETY (each `at` below): a queued pair lies among the block's
         // pairs, whose particles, images and history `Block::bounded`
         // bounded before the pass
-        let mass = |k: usize| unsafe { if p.any_frozen && at(p.frozen, k) { f64::INFINITY } else { at(p.mass, k) } };
         for l in 0..LANES {
-            let pk = queue[l.min(last)];
+            let pk = pair(l);
             let (i, j, img) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize, at(k.image, pk) as usize) };
+            cross |= ((j.wrapping_sub(k.lo) >= f.len()) as u32) << l;
             unsafe {
                 put(&mut s.xi, l, &at(p.x, i));
                 put(&mut s.xj, l, &(at(p.x, j) + at(k.images, img)));
@@ -996,8 +1000,11 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 s.ri.0[l] = at(p.radius, i);
                 s.rj.0[l] = at(p.radius, j);
             }
-            s.mi.0[l] = mass(i);
-            s.mj.0[l] = mass(j);
+            // masses as contacts see them (`contact_mass`): frozen ones below
+            unsafe {
+                s.mi.0[l] = at(p.mass, i);
+                s.mj.0[l] = at(p.mass, j);
+            }
             if !one_type {
                 let pp = unsafe { k.table.get(at(p.kind, i), at(p.kind, j)) };
                 coeffs.uniform &= std::ptr::eq(pp, p0);
@@ -1008,10 +1015,23 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 v.0[l] = unsafe { at(h, h0 + m) };
             }
         }
-        // which lanes touch, as the walk decides it (the same operations:
-        // r^2 summed x + y + z, the reach ri + rj plus the extra range)
+        if p.any_frozen {
+            for l in 0..LANES {
+                let pk = pair(l);
+                // SAFETY: as the gather's
+                let (i, j) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize) };
+                if p.frozen[i] {
+                    s.mi.0[l] = f64::INFINITY;
+                }
+                if p.frozen[j] {
+                    s.mj.0[l] = f64::INFINITY;
+                }
+            }
+        }
         // the lanes whose forces are added, as bits: every queued one, or in
-        // a dense batch those that touch
+        // a dense batch those that touch (decided as the walk decides it, by
+        // the same operations: r^2 summed x + y + z, the reach ri + rj plus
+        // the extra range)
         let mut touch = u32::MAX;
         if DENSE {
             let r2 = (s.xi - s.xj).norm_squared();
@@ -1022,9 +1042,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             let rr = reach * reach;
             let apart = r2.ge(rr).bits() & ((1u32 << last) << 1).wrapping_sub(1);
             touch = !apart & r2.ne(F8::splat(0.0)).bits();
-            // SAFETY: a dense batch's pairs are consecutive from queue[0],
+            // SAFETY: a dense batch's pairs are consecutive from `first`,
             // the block's ([`Block::bounded`])
-            unsafe { batch_came_apart(h, lv, queue[0] - k.ps, last + 1, w, apart) };
+            unsafe { batch_came_apart(h, lv, first - k.ps, last + 1, w, apart) };
         }
         let c = contact_lanes(s, k.dt);
         let o = self.apply_lanes(&c, &coeffs, &mut hist[..w]);
@@ -1039,7 +1059,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             if DENSE && touch >> l & 1 == 0 {
                 continue;
             }
-            let pk = queue[l];
+            let pk = pair(l);
             let q = pk - k.ps;
             // SAFETY (each `at` and `at_mut` below): as the gather's; `i` is
             // the block's, `j` is where the branch says
@@ -1068,10 +1088,21 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                     *at_mut(tq, j - k.lo) += tj.lane(l);
                 }
             } else {
-                d[k.xs[slots[l]] as usize] = [fl, tj.lane(l)];
+                let sl = if DENSE { *slot + (cross & ((1u32 << l) - 1)).count_ones() as usize } else { slots[l] };
+                d[k.xs[sl] as usize] = [fl, tj.lane(l)];
             }
         }
+        if DENSE {
+            *slot += (cross & ((1u32 << last) << 1).wrapping_sub(1)).count_ones() as usize;
+        }
     }
+}
+
+/// A dense batch's pairs: `first` and those after it, their cross slots
+/// counted on from `slot` (see [`Laws::run_batch`]).
+struct Dense<'a> {
+    first: usize,
+    slot: &'a mut usize,
 }
 
 /// The lanes of a batch of the batched pass: the pairs' state and history.
