@@ -863,7 +863,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// or not: each batch decides which of its lanes touch by the walk's
     /// test, on lanes, and adds the forces of those alone, in pair order:
     /// the same contributions in the same order as [`Self::block_walk`].
-    #[inline(always)]
+    #[inline(never)]
     fn block_dense(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
         let w = Self::WIDTH;
         // a dense batch's pairs are consecutive: no queue, and their cross
@@ -888,7 +888,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
 
     /// A block's pairs walked one by one: those apart are sorted out, the
     /// touching ones queued and run in batches.
-    #[inline(always)]
+    #[inline(never)]
     fn block_walk(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
         let p = k.p;
         let w = Self::WIDTH;
@@ -911,20 +911,26 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         for (q, ((&i, &j), &img)) in pairs.enumerate() {
             prefetch_ahead(k, h, q, w);
             let (i, j) = (i as usize, j as usize);
-            let xj = p.x[j] + k.images[img as usize];
+            // SAFETY (each `at` and `at_mut` below): the block's pairs, whose
+            // particles and images `Block::bounded` bounded; `queued` is
+            // below LANES (a full queue is run and emptied)
+            let (xi, xj, ri, rj) = unsafe { (at(p.x, i), at(p.x, j) + at(k.images, img as usize), at(p.radius, i), at(p.radius, j)) };
             let reach = if C::NONCONTACT {
                 let extra = if one_type { extra0 } else { k.table.get(p.kind[i], p.kind[j]).extra_range };
-                p.radius[i] + p.radius[j] + extra
+                ri + rj + extra
             } else {
-                p.radius[i] + p.radius[j]
+                ri + rj
             };
-            let r2 = (p.x[i] - xj).norm_squared();
+            let r2 = (xi - xj).norm_squared();
             // no branch on touching, which is a coin toss for pairs in the
             // skin: every pair is written to the queue, touching ones stay
             let apart = r2 >= reach * reach;
             let touch = !apart & (r2 != 0.0);
-            queue[queued] = k.ps + q;
-            slots[queued] = slot;
+            debug_assert!(queued < LANES);
+            unsafe {
+                *at_mut(&mut queue, queued) = k.ps + q;
+                *at_mut(&mut slots, queued) = slot;
+            }
             slot += (j.wrapping_sub(lo) >= len) as usize;
             queued += touch as usize;
             // SAFETY: q < pe - ps, the block's pairs ([`Block::bounded`])
