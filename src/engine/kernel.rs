@@ -974,12 +974,13 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let w = Self::WIDTH;
         let BatchLanes { s, hist } = lanes;
         let one_type = k.table.ntypes == 1;
-        // with one type, types are not read (as in the walk): each batch's
-        // first partner's type was a line from memory on a large bed
         debug_assert!((1..=LANES).contains(&count));
         let last = count.clamp(1, LANES) - 1;
         let Dense { first, slot } = dense;
+        // lane l's pair (lanes past `count` repeat the last)
         let pair = |l: usize| if DENSE { first + l.min(last) } else { queue[l.min(last)] };
+        // with one type, types are not read (as in the walk): each batch's
+        // first partner's type was a line from memory on a large bed
         let p0 = if one_type { k.table.get(1, 1) } else { k.table.get(p.kind[k.a[pair(0)] as usize], p.kind[k.b[pair(0)] as usize]) };
         let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
         let put = |v: &mut Vec3<F8>, l: usize, x: &V3| {
@@ -1060,7 +1061,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // and the laws' output, which then need not be kept in memory (a
         // lane read at a varying index pins the whole struct there: each
         // batch copied both)
-        let (delta, ti, tj) = (c.delta, o.torque_i, o.torque_j);
+        let (overlap, ti, tj) = (c.delta, o.torque_i, o.torque_j);
         for l in 0..count.min(LANES) {
             if DENSE && touch >> l & 1 == 0 {
                 continue;
@@ -1070,7 +1071,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             // SAFETY (each `at` and `at_mut` below): as the gather's; `i` is
             // the block's, `j` is where the branch says
             let (i, j) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize) };
-            let delta = delta.0[l];
+            let delta = overlap.0[l];
             let beyond = if C::NONCONTACT { delta <= -coeffs.p[l].extra_range } else { delta <= 0.0 };
             if beyond {
                 // within reach by r^2 but not by the overlap (rounding): apart,
