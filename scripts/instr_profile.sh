@@ -35,13 +35,27 @@ text = subprocess.run(["callgrind_annotate", "--inclusive=yes", out], capture_ou
 ps = atoms * steps
 total = int(re.search(r"([\d,]+) \([^)]*\)\s+PROGRAM TOTALS", text).group(1).replace(",", ""))
 print(f"whole run (start-up included): {total / ps:.0f} instructions per particle-step")
-for line in text.splitlines():
-    m = re.match(r"\s*([\d,]+) \(\s*[\d.]+%\)\s+\S*kernel\.rs:<demx::engine::kernel::Laws.*force_pass::\{\{closure\}\}'2", line)
-    if m:
-        print(f"force pass blocks (inclusive): {int(m.group(1).replace(',', '')) / ps:.0f} instructions per particle-step")
-        break
-else:
-    # the block closure's symbol is the compiler's name for it, and may change
+def inclusive(pattern):
+    """The first inclusive count whose symbol matches `pattern` (a line of
+    its own, not a call line `=>`), or None."""
+    for line in text.splitlines():
+        m = re.match(r"\s*([\d,]+) \(\s*[\d.]+%\)\s+(\S+)", line)
+        if m and m.group(2) != "=>" and re.search(pattern, m.group(2) + line[m.end():]):
+            return int(m.group(1).replace(",", ""))
+    return None
+
+# the pass: its blocks (dense and walked, compiled as functions of their
+# own) and what the block closure adds around them (the bounds check, the
+# zero fills); the closure also runs each finished block's tail (the cross
+# shares and the integration), which is not the pass and is taken off
+closure = inclusive(r"kernel\.rs:<demx::engine::kernel::Laws.*force_pass::\{\{closure\}\} ")
+tails = [inclusive(r"kernel\.rs:demx::engine::kernel::cross_gather_chunk "), inclusive(r"sim\.rs:demx::engine::sim::Sim::fused_pass::\{\{closure\}\} ")]
+blocks = [inclusive(r"kernel\.rs:demx::engine::kernel::Laws.*::block_dense "), inclusive(r"kernel\.rs:demx::engine::kernel::Laws.*::block_walk ")]
+if closure is None or None in tails:
+    # the compiler's names for closures may change
     print("force pass: its closure's symbol was not found; read target/v3/callgrind.txt")
+else:
+    print(f"force pass (its closure less the finished blocks' tails): {(closure - sum(tails)) / ps:.0f} instructions per particle-step")
+print(f"of which the blocks' pairs (block_dense + block_walk): {sum(b or 0 for b in blocks) / ps:.0f}")
 EOF
 echo "per source line: target/v3/callgrind.txt"
