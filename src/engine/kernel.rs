@@ -648,18 +648,42 @@ fn prefetch<T>(s: &[T], k: usize) {
     let _ = (s, k);
 }
 
+/// Ask the cache for `s[k]`'s last byte: the second line of an element
+/// that straddles two (a quarter of the 24-byte vectors), else a hint for
+/// a line already asked for.
+#[inline(always)]
+fn prefetch_end<T>(s: &[T], k: usize) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: as in `prefetch`
+    unsafe {
+        let end = (s.as_ptr().wrapping_add(k + 1) as *const i8).wrapping_sub(1);
+        core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(end);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (s, k);
+}
+
 /// Ask the cache for the partner of the block's pair `q + PREFETCH_AHEAD`
 /// and that pair's history (`w` values a pair). Partners lie later in
 /// storage, those across a block boundary often far later (the spatial
 /// order keeps most neighbours close in memory, not all), and on beds
-/// beyond the cache each first touch of one waits on DRAM.
+/// beyond the cache each first touch of one waits on DRAM. `BOTH`: the
+/// partner's vectors whole, both lines of those that straddle two; where
+/// every pair is a contact (dense blocks) the batch reads them all, and on
+/// a bed of 480,000 spheres its loads waited on the second lines. The walk
+/// reads only the position of most pairs, and the chute ran slower with it.
 #[inline(always)]
-fn prefetch_ahead(k: &Block<'_>, h: &[f64], q: usize, w: usize) {
+fn prefetch_ahead<const BOTH: bool>(k: &Block<'_>, h: &[f64], q: usize, w: usize) {
     let ahead = k.b[(k.ps + q + PREFETCH_AHEAD).min(k.pe.saturating_sub(1))] as usize;
     let p = k.p;
     prefetch(p.x, ahead);
     prefetch(p.v, ahead);
     prefetch(p.omega, ahead);
+    if BOTH {
+        prefetch_end(p.x, ahead);
+        prefetch_end(p.v, ahead);
+        prefetch_end(p.omega, ahead);
+    }
     prefetch(p.radius, ahead);
     prefetch(p.mass, ahead);
     prefetch(h, (q + PREFETCH_AHEAD) * w);
@@ -877,7 +901,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         while q0 < n {
             let count = (n - q0).min(LANES);
             for l in 0..count {
-                prefetch_ahead(k, h, q0 + l, w);
+                prefetch_ahead::<true>(k, h, q0 + l, w);
             }
             let dense = Dense { first: k.ps + q0, slot: &mut slot };
             self.run_batch::<true>(k, &mut lanes, &none, &none, dense, count, h, d, lv, f, tq, &mut virial);
@@ -909,7 +933,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let extra0 = if C::NONCONTACT { k.table.get(1, 1).extra_range } else { 0.0 };
         let pairs = k.a[k.ps..k.pe].iter().zip(&k.b[k.ps..k.pe]).zip(&k.image[k.ps..k.pe]);
         for (q, ((&i, &j), &img)) in pairs.enumerate() {
-            prefetch_ahead(k, h, q, w);
+            prefetch_ahead::<false>(k, h, q, w);
             let (i, j) = (i as usize, j as usize);
             // SAFETY (each `at` and `at_mut` below): the block's pairs, whose
             // particles and images `Block::bounded` bounded; `queued` is
