@@ -724,6 +724,17 @@ unsafe fn at<T: Copy>(s: &[T], k: usize) -> T {
     unsafe { *s.get_unchecked(k) }
 }
 
+/// `&s[k]`, as [`at`].
+///
+/// # Safety
+/// `k < s.len()`.
+#[inline(always)]
+unsafe fn at_ref<T>(s: &[T], k: usize) -> &T {
+    debug_assert!(k < s.len());
+    // SAFETY: the caller's
+    unsafe { s.get_unchecked(k) }
+}
+
 /// `&mut s[k]`, as [`at`].
 ///
 /// # Safety
@@ -1007,27 +1018,20 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // first partner's type was a line from memory on a large bed
         let p0 = if one_type { k.table.get(1, 1) } else { k.table.get(p.kind[k.a[pair(0)] as usize], p.kind[k.b[pair(0)] as usize]) };
         let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
-        let put = |v: &mut Vec3<F8>, l: usize, x: &V3| {
-            v.x.0[l] = x.x;
-            v.y.0[l] = x.y;
-            v.z.0[l] = x.z;
-        };
         // the lanes whose pair's second particle is in a later block (dense)
         let mut cross = 0u32;
         // SAFETY (each `at` below): a queued pair lies among the block's
         // pairs, whose particles, images and history `Block::bounded`
         // bounded before the pass
+        let mut ia = [0usize; LANES];
+        let mut ja = [0usize; LANES];
+        let mut ima = [0usize; LANES];
         for l in 0..LANES {
             let pk = pair(l);
             let (i, j, img) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize, at(k.image, pk) as usize) };
+            (ia[l], ja[l], ima[l]) = (i, j, img);
             cross |= ((j.wrapping_sub(k.lo) >= f.len()) as u32) << l;
             unsafe {
-                put(&mut s.xi, l, &at(p.x, i));
-                put(&mut s.xj, l, &(at(p.x, j) + at(k.images, img)));
-                put(&mut s.vi, l, &at(p.v, i));
-                put(&mut s.vj, l, &at(p.v, j));
-                put(&mut s.wi, l, &at(p.omega, i));
-                put(&mut s.wj, l, &at(p.omega, j));
                 s.ri.0[l] = at(p.radius, i);
                 s.rj.0[l] = at(p.radius, j);
             }
@@ -1045,6 +1049,15 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             for (m, v) in hist[..w].iter_mut().enumerate() {
                 v.0[l] = unsafe { at(h, h0 + m) };
             }
+        }
+        // SAFETY (each `at_ref`): as the loop's
+        unsafe {
+            s.xi = Vec3::rows(ia.map(|i| at_ref(p.x, i)));
+            s.xj = Vec3::rows_plus(ja.map(|j| at_ref(p.x, j)), ima.map(|m| at_ref(k.images, m)));
+            s.vi = Vec3::rows(ia.map(|i| at_ref(p.v, i)));
+            s.vj = Vec3::rows(ja.map(|j| at_ref(p.v, j)));
+            s.wi = Vec3::rows(ia.map(|i| at_ref(p.omega, i)));
+            s.wj = Vec3::rows(ja.map(|j| at_ref(p.omega, j)));
         }
         if p.any_frozen {
             for l in 0..LANES {

@@ -272,6 +272,46 @@ mod wide {
         // SAFETY: as in `halves`
         unsafe { (_mm256_movemask_pd(m.0[0]) | _mm256_movemask_pd(m.0[1]) << 4) as u32 }
     }
+    /// x, y, z of `v`, and a zero.
+    #[inline(always)]
+    fn row(v: &crate::physics::V3) -> __m256d {
+        let p = v.as_ptr();
+        // SAFETY: `p` is three f64 in a row (nalgebra's column storage);
+        // as in `halves` for the instructions
+        #[cfg(target_feature = "avx512vl")]
+        // SAFETY: the masked-off fourth lane is not read (nor can it fault)
+        return unsafe { _mm256_maskz_loadu_pd(0b0111, p) };
+        #[cfg(not(target_feature = "avx512vl"))]
+        unsafe { _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(_mm_loadu_pd(p)), _mm_load_sd(p.add(2))) }
+    }
+    /// Four rows of x, y, z (and a lane not read) as x, y and z of four lanes.
+    #[inline(always)]
+    fn columns(r: [__m256d; 4]) -> [__m256d; 3] {
+        // SAFETY: as in `halves`
+        unsafe {
+            let xz01 = _mm256_unpacklo_pd(r[0], r[1]);
+            let y01 = _mm256_unpackhi_pd(r[0], r[1]);
+            let xz23 = _mm256_unpacklo_pd(r[2], r[3]);
+            let y23 = _mm256_unpackhi_pd(r[2], r[3]);
+            [
+                _mm256_permute2f128_pd::<0x20>(xz01, xz23),
+                _mm256_permute2f128_pd::<0x20>(y01, y23),
+                _mm256_permute2f128_pd::<0x31>(xz01, xz23),
+            ]
+        }
+    }
+    /// See `Vec3::rows`.
+    #[inline(always)]
+    pub(super) fn rows(rows: [&crate::physics::V3; 8], plus: Option<[&crate::physics::V3; 8]>) -> super::Vec3<F8> {
+        let reg = |l: usize| match plus {
+            // SAFETY: as in `halves`
+            Some(p) => unsafe { _mm256_add_pd(row(rows[l]), row(p[l])) },
+            None => row(rows[l]),
+        };
+        let lo = columns([reg(0), reg(1), reg(2), reg(3)]);
+        let hi = columns([reg(4), reg(5), reg(6), reg(7)]);
+        super::Vec3 { x: f([lo[0], hi[0]]), y: f([lo[1], hi[1]]), z: f([lo[2], hi[2]]) }
+    }
     #[inline(always)]
     pub(super) fn select(m: M8, a: F8, b: F8) -> F8 {
         let (a, b) = (r(a), r(b));
@@ -529,6 +569,30 @@ impl Vec3<F8> {
     pub fn lane(&self, l: usize) -> super::V3 {
         super::V3::new(self.x.0[l], self.y.0[l], self.z.0[l])
     }
+    /// Lane `l` from `rows[l]`: eight vectors turned into lanes. With AVX2,
+    /// each row is one register (one masked load with AVX-512VL) and four
+    /// rows become three registers of lanes by seven shuffles, where lane by
+    /// lane it took a load and a store for each value and then a wide load
+    /// of what the narrow stores wrote (which waits for those stores).
+    #[inline(always)]
+    pub fn rows(rows: [&super::V3; LANES]) -> Vec3<F8> {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        return wide::rows(rows, None);
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        return Vec3 { x: F8(rows.map(|v| v.x)), y: F8(rows.map(|v| v.y)), z: F8(rows.map(|v| v.z)) };
+    }
+    /// Lane `l` from `rows[l] + plus[l]` (added as nalgebra adds, component
+    /// by component).
+    #[inline(always)]
+    pub fn rows_plus(rows: [&super::V3; LANES], plus: [&super::V3; LANES]) -> Vec3<F8> {
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        return wide::rows(rows, Some(plus));
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        {
+            let sum: [super::V3; LANES] = std::array::from_fn(|l| rows[l] + plus[l]);
+            return Vec3 { x: F8(sum.map(|v| v.x)), y: F8(sum.map(|v| v.y)), z: F8(sum.map(|v| v.z)) };
+        }
+    }
 }
 
 /// Pair coefficients as lanes: one `PairParams` for one contact, or one per
@@ -625,5 +689,29 @@ mod tests {
             }
         }
         assert_eq!(checked, 16 * 2 * 8 * LANES);
+    }
+
+    /// `Vec3::rows` puts row l in lane l, and `rows_plus` the sum of two
+    /// rows with the bits of nalgebra's sum; the rows lie anywhere in a
+    /// slice, the last one at its very end (no read beyond a row).
+    #[test]
+    fn rows_become_lanes() {
+        use crate::physics::V3;
+        let v: Vec<V3> = (0..24).map(|k| V3::new(VALUES[k % 16], VALUES[(k + 5) % 16], 0.1 * k as f64 - 1.0)).collect();
+        let bits = |v: f64| if v.is_nan() { u64::MAX } else { v.to_bits() };
+        let picks = [[23, 0, 7, 7, 1, 12, 22, 3], [5, 9, 2, 17, 23, 11, 0, 8]];
+        for idx in picks {
+            for other in picks {
+                let rows = Vec3::rows(idx.map(|k| &v[k]));
+                let sums = Vec3::rows_plus(idx.map(|k| &v[k]), other.map(|k| &v[k]));
+                for l in 0..LANES {
+                    let (want, sum) = (v[idx[l]], v[idx[l]] + v[other[l]]);
+                    let got = [rows.x.0[l], rows.y.0[l], rows.z.0[l]].map(bits);
+                    assert_eq!(got, [want.x, want.y, want.z].map(bits), "rows, lane {l}");
+                    let got = [sums.x.0[l], sums.y.0[l], sums.z.0[l]].map(bits);
+                    assert_eq!(got, [sum.x, sum.y, sum.z].map(bits), "rows_plus, lane {l}");
+                }
+            }
+        }
     }
 }
