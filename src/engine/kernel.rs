@@ -1026,6 +1026,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let mut ia = [0usize; LANES];
         let mut ja = [0usize; LANES];
         let mut ima = [0usize; LANES];
+        let mut ha = [0usize; LANES];
         for l in 0..LANES {
             let pk = pair(l);
             let (i, j, img) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize, at(k.image, pk) as usize) };
@@ -1046,9 +1047,18 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 coeffs.p[l] = pp;
             }
             let h0 = (pk - k.ps) * w;
-            for (m, v) in hist[..w].iter_mut().enumerate() {
+            for (m, v) in hist[..w].iter_mut().enumerate().skip(w / 3 * 3) {
                 v.0[l] = unsafe { at(h, h0 + m) };
             }
+            ha[l] = h0;
+        }
+        // the history in threes as rows (as the vectors below), the rest
+        // lane by lane above
+        for c in 0..w / 3 {
+            // SAFETY: each pair's `w` values lie in `h` ([`Block::bounded`])
+            let three = |h0: usize| unsafe { &*(h.as_ptr().add(h0 + 3 * c) as *const [f64; 3]) };
+            let v = Vec3::rows_of(ha.map(three));
+            (hist[3 * c], hist[3 * c + 1], hist[3 * c + 2]) = (v.x, v.y, v.z);
         }
         // SAFETY (each `at_ref`): as the loop's
         unsafe {

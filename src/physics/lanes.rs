@@ -274,10 +274,10 @@ mod wide {
     }
     /// x, y, z of `v`, and a zero.
     #[inline(always)]
-    fn row(v: &crate::physics::V3) -> __m256d {
+    fn row(v: &[f64; 3]) -> __m256d {
         let p = v.as_ptr();
-        // SAFETY: `p` is three f64 in a row (nalgebra's column storage);
-        // as in `halves` for the instructions
+        // SAFETY: `p` is three f64 in a row; as in `halves` for the
+        // instructions
         #[cfg(target_feature = "avx512vl")]
         // SAFETY: the masked-off fourth lane is not read (nor can it fault)
         return unsafe { _mm256_maskz_loadu_pd(0b0111, p) };
@@ -302,7 +302,7 @@ mod wide {
     }
     /// See `Vec3::rows`.
     #[inline(always)]
-    pub(super) fn rows(rows: [&crate::physics::V3; 8], plus: Option<[&crate::physics::V3; 8]>) -> super::Vec3<F8> {
+    pub(super) fn rows(rows: [&[f64; 3]; 8], plus: Option<[&[f64; 3]; 8]>) -> super::Vec3<F8> {
         let reg = |l: usize| match plus {
             // SAFETY: as in `halves`
             Some(p) => unsafe { _mm256_add_pd(row(rows[l]), row(p[l])) },
@@ -576,17 +576,22 @@ impl Vec3<F8> {
     /// of what the narrow stores wrote (which waits for those stores).
     #[inline(always)]
     pub fn rows(rows: [&super::V3; LANES]) -> Vec3<F8> {
+        Vec3::rows_of(rows.map(|v| &v.data.0[0]))
+    }
+    /// [`Vec3::rows`] of three values in a row each (a pair's history).
+    #[inline(always)]
+    pub fn rows_of(rows: [&[f64; 3]; LANES]) -> Vec3<F8> {
         #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
         return wide::rows(rows, None);
         #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
-        return Vec3 { x: F8(rows.map(|v| v.x)), y: F8(rows.map(|v| v.y)), z: F8(rows.map(|v| v.z)) };
+        return Vec3 { x: F8(rows.map(|v| v[0])), y: F8(rows.map(|v| v[1])), z: F8(rows.map(|v| v[2])) };
     }
     /// Lane `l` from `rows[l] + plus[l]` (added as nalgebra adds, component
     /// by component).
     #[inline(always)]
     pub fn rows_plus(rows: [&super::V3; LANES], plus: [&super::V3; LANES]) -> Vec3<F8> {
         #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
-        return wide::rows(rows, Some(plus));
+        return wide::rows(rows.map(|v| &v.data.0[0]), Some(plus.map(|v| &v.data.0[0])));
         #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
         {
             let sum: [super::V3; LANES] = std::array::from_fn(|l| rows[l] + plus[l]);
