@@ -11,8 +11,8 @@ scripts/bench.py once, or its prepare(), to make it), and prints the minimum
 and median of each section time from demx's own log. This machine's speed
 drifts by tens of percent within minutes: interleaving and several rounds
 are what make two binaries comparable. --chute runs deck (c) instead, the
-LAMMPS chute (target/bench/in.chute and data.chute, which scripts/bench.py
-puts there).
+LAMMPS chute (../shared/bench/chute/in.chute, run in target/bench, where
+scripts/bench.py puts its data.chute).
 
 --side-by-side runs two binaries at once, one thread each, each pinned to its
 own core (`taskset`, the cores swapped every round), so that both see the
@@ -24,6 +24,7 @@ import argparse, os, statistics, subprocess
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WORK = os.path.join(ROOT, "target", "bench")
+CHUTE = os.path.join(os.path.dirname(ROOT), "shared", "bench", "chute", "in.chute")
 
 
 def main():
@@ -41,7 +42,7 @@ def main():
 
     def cmd(b, threads):
         if a.chute:
-            return [os.path.abspath(b), "run", "in.chute", "--log", "none", "--threads", threads, "-var", "nsteps", a.steps]
+            return [os.path.abspath(b), "run", CHUTE, "--log", "none", "--threads", threads, "-var", "nsteps", a.steps]
         return [os.path.abspath(b), "run", os.path.join(ROOT, "bench", "in.bed.liggghts"), "--log", "none",
                 "--threads", threads, "-var", "data", a.data, "-var", "nsteps", a.steps]
 
