@@ -1055,8 +1055,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // the history in threes as rows (as the vectors below), the rest
         // lane by lane above
         for c in 0..w / 3 {
-            // SAFETY: each pair's `w` values lie in `h` ([`Block::bounded`])
-            let three = |h0: usize| unsafe { &*(h.as_ptr().add(h0 + 3 * c) as *const [f64; 3]) };
+            let three = |h0: usize| {
+                debug_assert!(h0 + 3 * c + 3 <= h.len());
+                // SAFETY: each pair's `w` values lie in `h` ([`Block::bounded`]),
+                // and `3 * c + 3 <= w`
+                unsafe { &*(h.as_ptr().add(h0 + 3 * c) as *const [f64; 3]) }
+            };
             let v = Vec3::rows_of(ha.map(three));
             (hist[3 * c], hist[3 * c + 1], hist[3 * c + 2]) = (v.x, v.y, v.z);
         }
