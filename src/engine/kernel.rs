@@ -1020,13 +1020,15 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let mut coeffs = BatchCoeffs { p: [p0; LANES], uniform: true };
         // the lanes whose pair's second particle is in a later block (dense)
         let mut cross = 0u32;
-        // SAFETY (each `at` below): a queued pair lies among the block's
-        // pairs, whose particles, images and history `Block::bounded`
-        // bounded before the pass
+        // each lane's particles, image and first history value, for the rows
+        // below
         let mut ia = [0usize; LANES];
         let mut ja = [0usize; LANES];
         let mut ima = [0usize; LANES];
         let mut ha = [0usize; LANES];
+        // SAFETY (each `at` below): a queued pair lies among the block's
+        // pairs, whose particles, images and history `Block::bounded`
+        // bounded before the pass
         for l in 0..LANES {
             let pk = pair(l);
             let (i, j, img) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize, at(k.image, pk) as usize) };

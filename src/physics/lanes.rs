@@ -276,10 +276,10 @@ mod wide {
     #[inline(always)]
     fn row(v: &[f64; 3]) -> __m256d {
         let p = v.as_ptr();
-        // SAFETY: `p` is three f64 in a row; as in `halves` for the
-        // instructions
+        // SAFETY (both forms): `p` is three f64 in a row, and the masked-off
+        // fourth lane is neither read nor can it fault; as in `halves` for
+        // the instructions
         #[cfg(target_feature = "avx512vl")]
-        // SAFETY: the masked-off fourth lane is not read (nor can it fault)
         return unsafe { _mm256_maskz_loadu_pd(0b0111, p) };
         #[cfg(not(target_feature = "avx512vl"))]
         unsafe { _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(_mm_loadu_pd(p)), _mm_load_sd(p.add(2))) }
@@ -595,7 +595,7 @@ impl Vec3<F8> {
         #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
         {
             let sum: [super::V3; LANES] = std::array::from_fn(|l| rows[l] + plus[l]);
-            return Vec3 { x: F8(sum.map(|v| v.x)), y: F8(sum.map(|v| v.y)), z: F8(sum.map(|v| v.z)) };
+            return Vec3::rows(sum.each_ref());
         }
     }
 }
