@@ -406,11 +406,29 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             let h0 = out.hist.len();
             out.hist.resize(h0 + found.len() * w, 0.0);
             if let Carry::ByIndex { start, b, hist } = self.old {
-                let old = start[i] as usize..start[i + 1] as usize;
+                // the old pairs of i and the found ones are both sorted by
+                // second particle: one merge, not a scan of the old pairs
+                // per found pair (on the chute that scan was a third of
+                // the list's part of the build)
+                let (mut q, end) = (start[i] as usize, start[i + 1] as usize);
+                debug_assert!(b[q..end].is_sorted(), "old pairs of {i} not in order");
+                let (mut seen, mut from) = (None, None);
                 for (k, &(j, _)) in found.iter().enumerate() {
-                    // the last old pair (i, j) with non-zero history, as the
-                    // by-id map keeps it
-                    let from = old.clone().filter(|&q| b[q] == j).filter(|&q| hist[q * w..(q + 1) * w].iter().any(|&v| v != 0.0)).last();
+                    if seen != Some(j) {
+                        // the last old pair (i, j) with non-zero history, as
+                        // the by-id map keeps it (of any image)
+                        while q < end && b[q] < j {
+                            q += 1;
+                        }
+                        from = None;
+                        while q < end && b[q] == j {
+                            if hist[q * w..(q + 1) * w].iter().any(|&v| v != 0.0) {
+                                from = Some(q);
+                            }
+                            q += 1;
+                        }
+                        seen = Some(j);
+                    }
                     if let Some(q) = from {
                         out.hist[h0 + k * w..h0 + (k + 1) * w].copy_from_slice(&hist[q * w..(q + 1) * w]);
                     }
