@@ -279,19 +279,30 @@ pub fn contact_lanes<L: Real>(s: &PairState<L>, dt: f64) -> ContactL<L> {
     }
 }
 
-/// A particle's mass as its contacts see it: infinite when frozen.
+/// The masses of pair (i, j) as its contact sees them: a frozen particle's
+/// infinite, so that the effective mass is the other's alone; of two
+/// frozen ones, j's alone, so that the effective mass is i's (LAMMPS
+/// `pair gran/*`: meff = mj if i is frozen, then meff = mi if j is; both
+/// infinite would damp with an infinite mass, inf * 0 = NaN at rest).
 #[inline(always)]
-fn contact_mass(p: &PassState<'_>, k: usize) -> f64 {
-    if p.any_frozen && p.frozen[k] {
-        f64::INFINITY
-    } else {
-        p.mass[k]
+fn contact_masses(p: &PassState<'_>, i: usize, j: usize) -> (f64, f64) {
+    let (mut mi, mut mj) = (p.mass[i], p.mass[j]);
+    if p.any_frozen {
+        (mi, mj) = frozen_masses(p.frozen[i], p.frozen[j], mi, mj);
     }
+    (mi, mj)
+}
+
+/// [`contact_masses`] given the two frozen flags.
+#[inline(always)]
+fn frozen_masses(fi: bool, fj: bool, mi: f64, mj: f64) -> (f64, f64) {
+    (if fi && !fj { f64::INFINITY } else { mi }, if fj { f64::INFINITY } else { mj })
 }
 
 /// The state of pair (i, j) of one contact, j seen at `xj`.
 #[inline(always)]
 fn pair_state(p: &PassState<'_>, i: usize, j: usize, xj: V3) -> PairState<f64> {
+    let (mi, mj) = contact_masses(p, i, j);
     PairState {
         xi: p.x[i].into(),
         xj: xj.into(),
@@ -301,8 +312,8 @@ fn pair_state(p: &PassState<'_>, i: usize, j: usize, xj: V3) -> PairState<f64> {
         wj: p.omega[j].into(),
         ri: p.radius[i],
         rj: p.radius[j],
-        mi: contact_mass(p, i),
-        mj: contact_mass(p, j),
+        mi,
+        mj,
     }
 }
 
@@ -1038,7 +1049,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 s.ri.0[l] = at(p.radius, i);
                 s.rj.0[l] = at(p.radius, j);
             }
-            // masses as contacts see them (`contact_mass`): frozen ones below
+            // masses as contacts see them (`contact_masses`): frozen ones below
             unsafe {
                 s.mi.0[l] = at(p.mass, i);
                 s.mj.0[l] = at(p.mass, j);
@@ -1080,12 +1091,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 let pk = pair(l);
                 // SAFETY: as the gather's
                 let (i, j) = unsafe { (at(k.a, pk) as usize, at(k.b, pk) as usize) };
-                if p.frozen[i] {
-                    s.mi.0[l] = f64::INFINITY;
-                }
-                if p.frozen[j] {
-                    s.mj.0[l] = f64::INFINITY;
-                }
+                (s.mi.0[l], s.mj.0[l]) = frozen_masses(p.frozen[i], p.frozen[j], s.mi.0[l], s.mj.0[l]);
             }
         }
         // the lanes whose forces are added, as bits: every queued one, or in
@@ -1557,6 +1563,31 @@ mod tests {
             assert_eq!(frozen, heavy, "scalar pass: {scalar}");
             assert_ne!(frozen, light, "scalar pass: {scalar}: the frozen flags changed nothing");
         }
+    }
+
+    #[test]
+    fn two_frozen_partners_damp_with_the_first_mass() {
+        // LAMMPS pair gran/*: meff = mi mj / (mi + mj), then mj if i is
+        // frozen, then mi if j is
+        let (mi, mj) = (2.5, 0.75);
+        for (fi, fj) in [(false, false), (true, false), (false, true), (true, true)] {
+            let lammps = if fj { mi } else if fi { mj } else { mi * mj / (mi + mj) };
+            let (a, b) = frozen_masses(fi, fj, mi, mj);
+            assert_eq!(effective_mass(a, b), lammps, "i frozen {fi}, j frozen {fj}");
+        }
+        // a bed all frozen: every contact between two frozen particles, whose
+        // forces (and virial) stay finite on every path, with the same bits
+        let (laws, table) = gran_hooke();
+        let mut bed = random_bed(11);
+        bed.0.frozen.iter_mut().for_each(|f| *f = true);
+        let runs: Vec<_> = [false, true].map(|scalar| passes_on(&laws, &table, scalar, bed.clone())).into();
+        let dense = DENSE_ONLY.on_during(|| passes_on(&laws, &table, false, bed.clone()));
+        for (f, t, _, w) in runs.iter().flatten() {
+            let finite = f.iter().chain(t).chain([w]).all(|&b| f64::from_bits(b).is_finite());
+            assert!(finite, "a force, torque or the virial of two frozen partners is not finite");
+        }
+        assert_eq!(runs[0], runs[1]);
+        assert_eq!(dense, runs[1]);
     }
 
     #[test]
