@@ -11,7 +11,8 @@
 //! second deck gives gravity a variable magnitude, which its hook evaluates
 //! itself (not fused), between fused stages; a third adds a moving mesh,
 //! whose initial_integrate needs the whole simulation; a fourth freezes the
-//! bottom layer (`fix freeze`), whose partners then weigh as walls.
+//! bottom layer and spheres among the others (`fix freeze`), whose partners
+//! then weigh as walls.
 
 use demx::cli::{run_deck, DeckArgs};
 use demx::engine::sim::with_unfused_tail;
@@ -57,6 +58,13 @@ fn deck(dir: &str, gravity: &str, after: &str) -> String {
 /// The dump of one run on 2 threads, fused or not, and its pair-list
 /// builds; `after` goes after the integrator.
 fn run(gravity: &str, after: &str, fused: bool) -> (Vec<u8>, u64) {
+    let (dump, _, builds) = run_with(gravity, after, fused);
+    (dump, builds)
+}
+
+/// As [`run`], with the file `DIR/print.txt` that `after` may write
+/// (empty when it writes none).
+fn run_with(gravity: &str, after: &str, fused: bool) -> (Vec<u8>, Vec<u8>, u64) {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path().to_str().unwrap().to_string();
     std::fs::write(dir.path().join("data.spheres"), data()).unwrap();
@@ -70,7 +78,8 @@ fn run(gravity: &str, after: &str, fused: bool) -> (Vec<u8>, u64) {
     };
     let (r, builds) = pool.install(|| if fused { go() } else { with_unfused_tail(go) });
     assert!(r.is_ok(), "demx failed: {:?}", r.err());
-    (std::fs::read(dir.path().join("dump.spheres")).expect("dump written"), builds)
+    let printed = std::fs::read(dir.path().join("print.txt")).unwrap_or_default();
+    (std::fs::read(dir.path().join("dump.spheres")).expect("dump written"), printed, builds)
 }
 
 fn same((a, builds_a): &(Vec<u8>, u64), (b, builds_b): &(Vec<u8>, u64), what: &str) {
@@ -111,12 +120,24 @@ fn fused_head_and_tail_change_no_bit() {
     let fused_mesh = run(gravity, mesh, true);
     same(&fused_mesh, &run(gravity, mesh, false), "moving mesh");
     assert_ne!(fused_mesh, fused, "the mesh changed nothing");
-    // a frozen bottom layer: the fused pass, like the pass of the hooks on
-    // their own, gives their partners an infinite mass
-    let freeze = "group low id <= 225\nvelocity low set 0 0 0\nfix fr low freeze";
-    let fused_freeze = run(gravity, freeze, true);
-    same(&fused_freeze, &run(gravity, freeze, false), "frozen layer");
-    assert_ne!(fused_freeze, fused, "the frozen layer changed nothing");
+    // frozen spheres (the bottom layer and every seventh sphere above it):
+    // the fused pass, like the pass of the hooks on their own, gives their
+    // partners an infinite mass, and the force the fix takes off them
+    // (f_fr, in particle order whichever chunks took it; unequal forces,
+    // whose sum's bits depend on its order) has the same bits, printed
+    // every 50 steps
+    let freeze = "group bottom id <= 225\ngroup spread id 1:3375:7\ngroup low union bottom spread\n\
+                  velocity low set 0 0 0\nfix fr low freeze\n\
+                  fix pr all print 50 \"$(f_fr[1]:%.17g) $(f_fr[2]:%.17g) $(f_fr[3]:%.17g)\" file DIR/print.txt screen no";
+    let (dump, printed, builds) = run_with(gravity, freeze, true);
+    let (dump_u, printed_u, builds_u) = run_with(gravity, freeze, false);
+    same(&(dump.clone(), builds), &(dump_u, builds_u), "frozen layer");
+    assert_ne!((dump, builds), fused, "the frozen layer changed nothing");
+    let printed = String::from_utf8(printed).expect("text");
+    assert_eq!(printed, String::from_utf8(printed_u).expect("text"), "the freeze's removed force differs when fused");
+    // the frozen spheres bear the weight of the others, downwards
+    let fz: Vec<f64> = printed.lines().filter_map(|l| l.split_whitespace().nth(2)?.parse().ok()).collect();
+    assert!(fz.len() >= 10 && fz.iter().filter(|&&f| f < 0.0).count() > fz.len() / 2, "removed force not printed as expected: {printed}");
 }
 
 /// A tilted square across the box, 0.1-0.4 mm above the floor: it touches

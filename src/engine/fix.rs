@@ -76,6 +76,8 @@ pub struct Chunk<'a> {
     pub f: &'a mut [V3],
     /// The chunk's torques.
     pub torque: &'a mut [V3],
+    /// The chunk's frozen flags (fix freeze).
+    pub frozen: &'a mut [bool],
     /// The chunk's entries of each extra per-atom column (`width` values per
     /// particle, in the order of `Particles::extra`).
     pub extra: Vec<&'a mut [f64]>,

@@ -348,6 +348,7 @@ mod tests {
                 omega: &mut p.omega,
                 f: &mut p.f,
                 torque: &mut p.torque,
+                frozen: &mut p.frozen,
                 extra: vec![],
             };
             for s in stages {

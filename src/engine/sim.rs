@@ -353,11 +353,12 @@ impl Sim {
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, frozen, .. } = &mut self.particles;
         let n = x.len();
         let (mut fv, mut tv) = (std::mem::take(f), std::mem::take(torque));
-        let (xp, vp, wp) = (Shared(x.as_mut_ptr()), Shared(v.as_mut_ptr()), Shared(omega.as_mut_ptr()));
+        let (xp, vp, wp, zp) = (Shared(x.as_mut_ptr()), Shared(v.as_mut_ptr()), Shared(omega.as_mut_ptr()), Shared(frozen.as_mut_ptr()));
         let cols: Vec<(Shared<f64>, usize)> = extra.iter_mut().map(|e| (Shared(e.data.as_mut_ptr()), e.width)).collect();
         let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
-        // SAFETY: while the pass runs, positions, velocities and angular
-        // velocities are read through these and written only by `tail`,
+        // SAFETY: while the pass runs, positions, velocities, angular
+        // velocities and frozen flags are read through these and written
+        // only by `tail`,
         // each block's after every pass that reads them is over (the
         // dependency counts of `kernel::fused_blocks`), and by no one else
         let state = unsafe {
@@ -368,8 +369,8 @@ impl Sim {
                 radius,
                 mass,
                 kind,
-                frozen,
-                any_frozen: super::kernel::any(frozen),
+                frozen: std::slice::from_raw_parts(zp.ptr(), n),
+                any_frozen: super::kernel::any(std::slice::from_raw_parts(zp.ptr(), n)),
             }
         };
         let bs = self.pairs.block_size();
@@ -382,15 +383,16 @@ impl Sim {
             let (lo, len) = (s * bs, f.len());
             // SAFETY: block s's entries, which no pass reads any more and no
             // other finish touches (see `state`)
-            let (x, v, omega, extra) = unsafe {
+            let (x, v, omega, frozen, extra) = unsafe {
                 (
                     std::slice::from_raw_parts_mut(xp.ptr().add(lo), len),
                     std::slice::from_raw_parts_mut(vp.ptr().add(lo), len),
                     std::slice::from_raw_parts_mut(wp.ptr().add(lo), len),
+                    std::slice::from_raw_parts_mut(zp.ptr().add(lo), len),
                     cols.iter().map(|&(c, w)| std::slice::from_raw_parts_mut(c.ptr().add(lo * w), len * w)).collect(),
                 )
             };
-            let travel = finish(Chunk { lo, x, radius, mass, kind, mask, v, omega, f, torque, extra }, pending, pairs, measure, lim);
+            let travel = finish(Chunk { lo, x, radius, mass, kind, mask, v, omega, f, torque, frozen, extra }, pending, pairs, measure, lim);
             *moved[s].lock().unwrap_or_else(PoisonError::into_inner) = travel;
             tail_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         };
@@ -644,7 +646,7 @@ impl Sim {
         }
         let cross = gather && !self.pairs.cross.is_empty();
         let (pairs, defer) = (&self.pairs, &self.pair_defer[..]);
-        let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, .. } = &mut self.particles;
+        let Particles { x, radius, mass, kind, mask, v, omega, f, torque, frozen, extra, .. } = &mut self.particles;
         let n = x.len();
         let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
         // each extra column cut at the chunks
@@ -656,8 +658,9 @@ impl Sim {
             .zip(omega.chunks_mut(TAIL_CHUNK))
             .zip(f.chunks_mut(TAIL_CHUNK))
             .zip(torque.chunks_mut(TAIL_CHUNK))
+            .zip(frozen.chunks_mut(TAIL_CHUNK))
             .enumerate()
-            .map(|(c, ((((x, v), omega), f), torque))| Chunk {
+            .map(|(c, (((((x, v), omega), f), torque), frozen))| Chunk {
                 lo: c * TAIL_CHUNK,
                 x,
                 radius,
@@ -668,6 +671,7 @@ impl Sim {
                 omega,
                 f,
                 torque,
+                frozen,
                 extra: cols.iter_mut().map(|it| it.next().unwrap_or_default()).collect(),
             })
             .collect();

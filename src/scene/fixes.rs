@@ -7,6 +7,7 @@ use crate::engine::integrate;
 use crate::engine::sim::Sim;
 use crate::error::{Error, Result};
 use crate::physics::V3;
+use std::sync::{Arc, Mutex, PoisonError};
 use crate::script::{Command, EvalContext, Variables};
 
 /// `fix ID group nve/sphere`.
@@ -207,12 +208,58 @@ pub struct Freeze {
     pub id: String,
     /// Group bit.
     pub group: u32,
-    /// Force removed this step (f_ID[1..3]).
-    pub removed: V3,
+    /// This step's frozen particles and the force each had (f_ID[1..3] is
+    /// their sum, taken in particle order: the bits of one serial pass,
+    /// however the step's chunks ran).
+    removed: Arc<Mutex<Vec<(usize, V3)>>>,
+}
+
+impl Freeze {
+    /// The fix, with nothing removed yet.
+    pub fn new(id: String, group: u32) -> Freeze {
+        Freeze { id, group, removed: Arc::default() }
+    }
+
+    fn removed(&self) -> std::sync::MutexGuard<'_, Vec<(usize, V3)>> {
+        self.removed.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// Freeze's post_force on the particles of one chunk (the fix's stage in
+/// the step's fused tail, and its whole pass): each particle on its own.
+struct Hold {
+    group: u32,
+    removed: Arc<Mutex<Vec<(usize, V3)>>>,
+}
+
+impl Hold {
+    fn hold(&self, lo: usize, mask: &[u32], frozen: &mut [bool], f: &mut [V3], torque: &mut [V3]) {
+        let mut took = Vec::new();
+        for (k, (((&bits, fz), f), t)) in mask.iter().zip(frozen).zip(f).zip(torque).enumerate() {
+            if bits & self.group != 0 {
+                *fz = true;
+                took.push((lo + k, *f));
+                *f = V3::zeros();
+                *t = V3::zeros();
+            }
+        }
+        if !took.is_empty() {
+            self.removed.lock().unwrap_or_else(PoisonError::into_inner).extend(took);
+        }
+    }
+}
+
+impl Stage for Hold {
+    fn apply(&self, c: &mut Chunk<'_>) {
+        let r = c.lo..c.lo + c.f.len();
+        self.hold(c.lo, &c.mask[r], c.frozen, c.f, c.torque);
+    }
 }
 
 impl Fix for Freeze {
-    crate::post_force_only!();
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
     fn id(&self) -> &str {
         &self.id
     }
@@ -229,20 +276,34 @@ impl Fix for Freeze {
         Ok(())
     }
     fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
+        self.removed().clear();
         let p = &mut sim.particles;
-        self.removed = V3::zeros();
-        for i in 0..p.len() {
-            if p.mask[i] & self.group != 0 {
-                p.frozen[i] = true;
-                self.removed += p.f[i];
-                p.f[i] = V3::zeros();
-                p.torque[i] = V3::zeros();
-            }
-        }
+        Hold { group: self.group, removed: self.removed.clone() }.hold(0, &p.mask, &mut p.frozen, &mut p.f, &mut p.torque);
         Ok(())
     }
+    /// A stage of the step's fused tail: before, its whole pass split the
+    /// tail of every deck that freezes a group (the LAMMPS chute), so the
+    /// integration after it ran as a pass of its own, out of cache.
+    fn local(&mut self, hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
+        Ok(if hook == Hook::PostForce {
+            self.removed().clear();
+            Local::Stage(Box::new(Hold { group: self.group, removed: self.removed.clone() }))
+        } else {
+            Local::Nothing
+        })
+    }
     fn vector(&self, _sim: &Sim, i: usize) -> Option<f64> {
-        (1..=3).contains(&i).then(|| self.removed[i - 1])
+        (1..=3).contains(&i).then(|| self.removed_sum()[i - 1])
+    }
+}
+
+impl Freeze {
+    /// The force removed this step: the frozen particles' forces added in
+    /// particle order, whatever order the chunks took them in.
+    fn removed_sum(&self) -> V3 {
+        let mut took = self.removed().clone();
+        took.sort_unstable_by_key(|&(k, _)| k);
+        took.iter().fold(V3::zeros(), |s, &(_, f)| s + f)
     }
 }
 
@@ -457,7 +518,7 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
             let m = if let Magnitude::Const(m) = magnitude { m } else { 0.0 };
             Box::new(Gravity { id, group, acc: dir * m, magnitude, dir })
         }
-        "freeze" => Box::new(Freeze { id, group, removed: V3::zeros() }),
+        "freeze" => Box::new(Freeze::new(id, group)),
         "nve" => Box::new(Nve { id, group }),
         "ave/time" => Box::new(parse_ave_time(&id, a, sim.dry)?),
         "addforce" | "setforce" => {
@@ -489,6 +550,9 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
             let text = a.word("text")?.clone();
             let mut file = None;
             let mut screen = true;
+            // LAMMPS FixPrint: the file's first line is the title, by
+            // default "# Fix print output for fix ID"
+            let mut title = format!("# Fix print output for fix {id}");
             while a.more() {
                 let k = a.choice("print keyword", &["file", "append", "screen", "title"])?;
                 match k.text.as_str() {
@@ -502,14 +566,12 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
                         file = Some(f.map_err(|e| Error::io(w.span, format!("cannot open '{}'", w.text), &e))?);
                     }
                     "screen" => screen = a.yes_no("screen")?,
-                    _ => {
-                        let t = a.str("title")?;
-                        if let Some(f) = &mut file {
-                            use std::io::Write;
-                            let _ = writeln!(f, "{t}");
-                        }
-                    }
+                    _ => title = a.str("title")?.to_string(),
                 }
+            }
+            if let Some(f) = &mut file {
+                use std::io::Write;
+                let _ = writeln!(f, "{title}");
             }
             let _ = cmd;
             Box::new(Print { id, every, text, file, screen })
@@ -747,6 +809,65 @@ impl Fix for CheckTimestep {
             1 => Some(self.fractions.0),
             2 => Some(self.fractions.1),
             _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Freeze's stage on chunks taken last first, as the fused tail may
+    /// take them, removes the sum of one serial pass, bit for bit, and
+    /// leaves the frozen spheres flagged and without force or torque.
+    #[test]
+    fn freeze_stage_sums_in_particle_order_whatever_the_chunks_order() {
+        let n = 1000;
+        let fr = Freeze::new("fr".into(), 2);
+        // every third particle in the group, forces of unequal magnitudes
+        let mask: Vec<u32> = (0..n).map(|i| if i % 3 == 0 { 3 } else { 1 }).collect();
+        let force = |i: usize| V3::new((i as f64 * 0.37).sin() * 1e3, (i as f64).sqrt(), 1.0 / (1.0 + i as f64));
+        let mut f: Vec<V3> = (0..n).map(force).collect();
+        let mut torque = vec![V3::new(1.0, 2.0, 3.0); n];
+        let (mut x, mut v, mut omega) = (vec![V3::zeros(); n], vec![V3::zeros(); n], vec![V3::zeros(); n]);
+        let mut frozen = vec![false; n];
+        let (radius, mass, kind) = (vec![1.0; n], vec![1.0; n], vec![1; n]);
+        let stage = Hold { group: 2, removed: fr.removed.clone() };
+        let size = 128;
+        let mut chunks: Vec<Chunk<'_>> = x
+            .chunks_mut(size)
+            .zip(v.chunks_mut(size))
+            .zip(omega.chunks_mut(size))
+            .zip(f.chunks_mut(size))
+            .zip(torque.chunks_mut(size))
+            .zip(frozen.chunks_mut(size))
+            .enumerate()
+            .map(|(c, (((((x, v), omega), f), torque), frozen))| Chunk {
+                lo: c * size,
+                x,
+                radius: &radius,
+                mass: &mass,
+                kind: &kind,
+                mask: &mask,
+                v,
+                omega,
+                f,
+                torque,
+                frozen,
+                extra: vec![],
+            })
+            .collect();
+        for c in chunks.iter_mut().rev() {
+            stage.apply(c);
+        }
+        drop(chunks);
+        let serial = (0..n).filter(|i| i % 3 == 0).fold(V3::zeros(), |s, i| s + force(i));
+        let bits = |v: V3| [v.x, v.y, v.z].map(f64::to_bits);
+        assert_eq!(bits(fr.removed_sum()), bits(serial));
+        for i in 0..n {
+            let held = i % 3 == 0;
+            assert_eq!(frozen[i], held, "particle {i}");
+            assert_eq!(f[i] == V3::zeros() && torque[i] == V3::zeros(), held, "particle {i}");
         }
     }
 }

@@ -184,7 +184,7 @@ struct WallStage {
 
 impl Stage for WallStage {
     fn apply(&self, c: &mut Chunk<'_>) {
-        let Chunk { lo, x, v, omega, radius, mass, kind, mask, f, torque, extra } = c;
+        let Chunk { lo, x, v, omega, radius, mass, kind, mask, f, torque, extra, .. } = c;
         let (lo, hi) = (*lo as u32, (*lo + f.len()) as u32);
         let cands = &self.candidates[self.candidates.partition_point(|&i| i < lo)..];
         let qs = cands.iter().take_while(|&&i| i < hi).map(|&i| (i - lo) as usize);
