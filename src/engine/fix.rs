@@ -83,6 +83,39 @@ pub struct Chunk<'a> {
     pub extra: Vec<&'a mut [f64]>,
 }
 
+impl<'a> Chunk<'a> {
+    /// `p` cut into chunks of `size` particles (the last one shorter).
+    pub fn split(p: &'a mut super::particles::Particles, size: usize) -> Vec<Chunk<'a>> {
+        let super::particles::Particles { x, radius, mass, kind, mask, v, omega, f, torque, frozen, extra, .. } = p;
+        let n = x.len();
+        let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
+        // each extra column cut at the chunks
+        let mut cols: Vec<std::slice::ChunksMut<'_, f64>> = extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(size * e.width.max(1))).collect();
+        x.chunks_mut(size)
+            .zip(v.chunks_mut(size))
+            .zip(omega.chunks_mut(size))
+            .zip(f.chunks_mut(size))
+            .zip(torque.chunks_mut(size))
+            .zip(frozen.chunks_mut(size))
+            .enumerate()
+            .map(|(c, (((((x, v), omega), f), torque), frozen))| Chunk {
+                lo: c * size,
+                x,
+                radius,
+                mass,
+                kind,
+                mask,
+                v,
+                omega,
+                f,
+                torque,
+                frozen,
+                extra: cols.iter_mut().map(|it| it.next().unwrap_or_default()).collect(),
+            })
+            .collect()
+    }
+}
+
 /// A fix (LAMMPS `fix ID group style ...`). Hooks get the whole simulation
 /// with this fix taken out of it for the call.
 pub trait Fix: Send {

@@ -646,35 +646,7 @@ impl Sim {
         }
         let cross = gather && !self.pairs.cross.is_empty();
         let (pairs, defer) = (&self.pairs, &self.pair_defer[..]);
-        let Particles { x, radius, mass, kind, mask, v, omega, f, torque, frozen, extra, .. } = &mut self.particles;
-        let n = x.len();
-        let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
-        // each extra column cut at the chunks
-        let mut cols: Vec<std::slice::ChunksMut<'_, f64>> =
-            extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(TAIL_CHUNK * e.width.max(1))).collect();
-        let jobs: Vec<Chunk<'_>> = x
-            .chunks_mut(TAIL_CHUNK)
-            .zip(v.chunks_mut(TAIL_CHUNK))
-            .zip(omega.chunks_mut(TAIL_CHUNK))
-            .zip(f.chunks_mut(TAIL_CHUNK))
-            .zip(torque.chunks_mut(TAIL_CHUNK))
-            .zip(frozen.chunks_mut(TAIL_CHUNK))
-            .enumerate()
-            .map(|(c, (((((x, v), omega), f), torque), frozen))| Chunk {
-                lo: c * TAIL_CHUNK,
-                x,
-                radius,
-                mass,
-                kind,
-                mask,
-                v,
-                omega,
-                f,
-                torque,
-                frozen,
-                extra: cols.iter_mut().map(|it| it.next().unwrap_or_default()).collect(),
-            })
-            .collect();
+        let jobs = Chunk::split(&mut self.particles, TAIL_CHUNK);
         let pending = &*stages;
         let run = |c: Chunk<'_>| -> Travel {
             if cross {

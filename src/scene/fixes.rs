@@ -825,49 +825,24 @@ mod tests {
         let n = 1000;
         let fr = Freeze::new("fr".into(), 2);
         // every third particle in the group, forces of unequal magnitudes
-        let mask: Vec<u32> = (0..n).map(|i| if i % 3 == 0 { 3 } else { 1 }).collect();
         let force = |i: usize| V3::new((i as f64 * 0.37).sin() * 1e3, (i as f64).sqrt(), 1.0 / (1.0 + i as f64));
-        let mut f: Vec<V3> = (0..n).map(force).collect();
-        let mut torque = vec![V3::new(1.0, 2.0, 3.0); n];
-        let (mut x, mut v, mut omega) = (vec![V3::zeros(); n], vec![V3::zeros(); n], vec![V3::zeros(); n]);
-        let mut frozen = vec![false; n];
-        let (radius, mass, kind) = (vec![1.0; n], vec![1.0; n], vec![1; n]);
+        let mut p = crate::engine::particles::Particles::default();
+        for i in 0..n {
+            let mask = if i % 3 == 0 { 3 } else { 1 };
+            p.push(crate::engine::particles::NewParticle { tag: i as i64 + 1, kind: 1, mask, x: V3::zeros(), v: V3::zeros(), omega: V3::zeros(), radius: 1.0, density: 1.0 });
+            (p.f[i], p.torque[i]) = (force(i), V3::new(1.0, 2.0, 3.0));
+        }
         let stage = Hold { group: 2, removed: fr.removed.clone() };
-        let size = 128;
-        let mut chunks: Vec<Chunk<'_>> = x
-            .chunks_mut(size)
-            .zip(v.chunks_mut(size))
-            .zip(omega.chunks_mut(size))
-            .zip(f.chunks_mut(size))
-            .zip(torque.chunks_mut(size))
-            .zip(frozen.chunks_mut(size))
-            .enumerate()
-            .map(|(c, (((((x, v), omega), f), torque), frozen))| Chunk {
-                lo: c * size,
-                x,
-                radius: &radius,
-                mass: &mass,
-                kind: &kind,
-                mask: &mask,
-                v,
-                omega,
-                f,
-                torque,
-                frozen,
-                extra: vec![],
-            })
-            .collect();
-        for c in chunks.iter_mut().rev() {
+        for c in Chunk::split(&mut p, 128).iter_mut().rev() {
             stage.apply(c);
         }
-        drop(chunks);
         let serial = (0..n).filter(|i| i % 3 == 0).fold(V3::zeros(), |s, i| s + force(i));
         let bits = |v: V3| [v.x, v.y, v.z].map(f64::to_bits);
         assert_eq!(bits(fr.removed_sum()), bits(serial));
         for i in 0..n {
             let held = i % 3 == 0;
-            assert_eq!(frozen[i], held, "particle {i}");
-            assert_eq!(f[i] == V3::zeros() && torque[i] == V3::zeros(), held, "particle {i}");
+            assert_eq!(p.frozen[i], held, "particle {i}");
+            assert_eq!(p.f[i] == V3::zeros() && p.torque[i] == V3::zeros(), held, "particle {i}");
         }
     }
 }
