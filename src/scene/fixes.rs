@@ -7,8 +7,8 @@ use crate::engine::integrate;
 use crate::engine::sim::Sim;
 use crate::error::{Error, Result};
 use crate::physics::V3;
-use std::sync::{Arc, Mutex, PoisonError};
 use crate::script::{Command, EvalContext, Variables};
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// `fix ID group nve/sphere`.
 pub struct NveSphere {
@@ -223,6 +223,14 @@ impl Freeze {
     fn removed(&self) -> std::sync::MutexGuard<'_, Vec<(usize, V3)>> {
         self.removed.lock().unwrap_or_else(PoisonError::into_inner)
     }
+
+    /// The force removed this step: the frozen particles' forces added in
+    /// particle order, whatever order the chunks took them in.
+    fn removed_sum(&self) -> V3 {
+        let mut took = self.removed().clone();
+        took.sort_unstable_by_key(|&(k, _)| k);
+        took.iter().fold(V3::zeros(), |s, &(_, f)| s + f)
+    }
 }
 
 /// Freeze's post_force on the particles of one chunk (the fix's stage in
@@ -294,16 +302,6 @@ impl Fix for Freeze {
     }
     fn vector(&self, _sim: &Sim, i: usize) -> Option<f64> {
         (1..=3).contains(&i).then(|| self.removed_sum()[i - 1])
-    }
-}
-
-impl Freeze {
-    /// The force removed this step: the frozen particles' forces added in
-    /// particle order, whatever order the chunks took them in.
-    fn removed_sum(&self) -> V3 {
-        let mut took = self.removed().clone();
-        took.sort_unstable_by_key(|&(k, _)| k);
-        took.iter().fold(V3::zeros(), |s, &(_, f)| s + f)
     }
 }
 
