@@ -305,18 +305,8 @@ pub fn run_engine(dir: &Path, deck_name: &str, run: &EngineRun) -> Result<Engine
     let err_file = out_file
         .try_clone()
         .map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", screen.display()), &e))?;
-    // Open MPI (under both engines, even on one rank) makes its session
-    // directory `ompi.<host>.<uid>` under TMPDIR; two engines starting at
-    // the same moment race on that mkdir and one aborts ("File exists"):
-    // each run on one rank gets a TMPDIR of its own (not under mpirun, whose
-    // ranks then report a PMIx permission error)
-    let tmp = tempfile::tempdir().map_err(|e| Error::io(Span::DUMMY, "cannot make a temporary directory for the engine", &e))?;
-    let mut cmd = Command::new(&argv[0]);
-    if argv[0] != "mpirun" {
-        cmd.env("TMPDIR", tmp.path());
-    }
     let t0 = Instant::now();
-    let status = cmd
+    let status = Command::new(&argv[0])
         .args(&argv[1..])
         .current_dir(dir)
         .stdin(Stdio::null())
