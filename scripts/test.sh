@@ -5,4 +5,35 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cargo test --no-fail-fast "$@"
+# Open MPI (under both engines, even on one rank) creates its session
+# directory /tmp/ompi.<host>.<uid> at start when it is missing, and an
+# engine's end may remove it again; two engines starting at once can race on
+# that mkdir, and the loser aborts in MPI_Init before reading its deck ("unable
+# to create the desired directory ... File exists": a clean-clone CI run on
+# 2026-12-06, in tests that start engines in parallel). For the tests, each
+# engine runs through a wrapper, first on PATH, that starts it again when its
+# output says it lost that race (a TMPDIR per run avoided the race but made
+# PMIx print errors on every run, which the tests read).
+wrap=$(mktemp -d)
+trap 'rm -rf "$wrap"' EXIT
+for e in liggghts lmp; do
+    real=$(command -v "$e") || continue
+    cat > "$wrap/$e" <<WRAP
+#!/bin/sh
+# a rank that mpirun starts has mpirun's session: run it as it is
+[ -n "\$OMPI_COMM_WORLD_SIZE" ] && exec "$real" "\$@"
+out=\$(mktemp); err=\$(mktemp)
+for try in 1 2 3 4 5; do
+    "$real" "\$@" > "\$out" 2> "\$err"
+    rc=\$?
+    [ \$rc -ne 0 ] && grep -qs "unable to create the desired directory" "\$out" "\$err" || break
+    # the racers wait different times (their pids)
+    sleep "0.\$(( \$\$ % 9 + 1 ))"
+done
+cat "\$out"; cat "\$err" >&2
+rm -f "\$out" "\$err"
+exit \$rc
+WRAP
+    chmod +x "$wrap/$e"
+done
+PATH="$wrap:$PATH" cargo test --no-fail-fast "$@"
