@@ -140,6 +140,10 @@ pub struct PairList {
     pub retry_in: u32,
     /// What the last check measured (see [`Travel`]).
     pub travel: Travel,
+    /// The second particles and history of the list before the last build,
+    /// which the next build writes its list into while it reads the current
+    /// one's history (no fresh pages for them on every build).
+    pub(crate) spare: (Vec<u32>, Vec<f64>),
 }
 
 /// The larger of a running maximum `m` and `d`, which a NaN `d` leaves as
@@ -265,13 +269,12 @@ enum Carry {
     ById(HashMap<(i64, i64), (bool, Vec<f64>), BuildHasherDefault<IdHasher>>),
 }
 
-/// The pairs whose first particle lies in `lo..lo + count.len()`.
-struct Chunk {
-    lo: usize,
-    count: Vec<u32>,
-    b: Vec<u32>,
-    image: Vec<u8>,
-    hist: Vec<f64>,
+/// Where a chunk of the build writes its pairs: its range of the list.
+struct Place<'a> {
+    a: &'a mut [u32],
+    b: &'a mut [u32],
+    image: &'a mut [u8],
+    hist: &'a mut [f64],
 }
 
 /// What the per-chunk build reads.
@@ -379,17 +382,10 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
     /// (those it found itself, in `found_own`, and those later particles
     /// found, in `foreign` from `fstart`) in order of storage index and
     /// shift, with the history each carries.
-    fn chunk(&self, range: std::ops::Range<usize>, found_own: &Found, fstart: &[u32], foreign: &[(u32, u8)]) -> Chunk {
+    fn chunk(&self, range: std::ops::Range<usize>, found_own: &Found, fstart: &[u32], foreign: &[(u32, u8)], out: Place<'_>) {
         let w = self.width;
-        // room for the pairs per particle of the last build, plus a margin
-        let room = range.len() * (self.per_particle + 2);
-        let mut out = Chunk {
-            lo: range.start,
-            count: Vec::with_capacity(range.len()),
-            b: Vec::with_capacity(room),
-            image: Vec::with_capacity(room),
-            hist: Vec::with_capacity(room * w),
-        };
+        // the next pair's place
+        let mut at = 0;
         let mut found: Vec<(u32, u8)> = Vec::new();
         for i in range.clone() {
             let k = i - range.start;
@@ -398,13 +394,14 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             found.extend_from_slice(&foreign[fstart[i] as usize..fstart[i + 1] as usize]);
             // by storage index, then shift (periodic images of one pair)
             found.sort_unstable_by(|u, v| u.0.cmp(&v.0).then_with(|| cmp_v3(&self.images[u.1 as usize], &self.images[v.1 as usize])));
-            out.count.push(found.len() as u32);
-            for &(j, img) in &found {
-                out.b.push(j);
-                out.image.push(img);
+            let len = found.len();
+            out.a[at..at + len].fill(i as u32);
+            for ((b, image), &(j, img)) in out.b[at..at + len].iter_mut().zip(&mut out.image[at..at + len]).zip(&found) {
+                (*b, *image) = (j, img);
             }
-            let h0 = out.hist.len();
-            out.hist.resize(h0 + found.len() * w, 0.0);
+            let h0 = at * w;
+            out.hist[h0..h0 + len * w].fill(0.0);
+            at += len;
             if let Carry::ByIndex { start, b, hist } = self.old {
                 // the old pairs of i and the found ones are both sorted by
                 // second particle: one merge, not a scan of the old pairs
@@ -435,7 +432,7 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
                 }
             }
         }
-        out
+        debug_assert_eq!(at, out.b.len(), "a chunk's pairs not as counted");
     }
 }
 
@@ -685,7 +682,7 @@ impl PairList {
         let images: Vec<V3> =
             (0..27).map(|c: i64| V3::new((c % 3 - 1) as f64 * lens[0], ((c / 3) % 3 - 1) as f64 * lens[1], (c / 9 - 1) as f64 * lens[2])).collect();
         let carry = self.carry_source(p, width);
-        let mut chunks: Vec<Chunk> = Vec::new();
+        let mut built = None;
         if n > 0 {
             let rmax = p.radius.iter().cloned().fold(0.0, f64::max);
             // extra range is per type pair: its maximum over the present types
@@ -701,32 +698,62 @@ impl PairList {
             let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width, per_particle };
             let found = in_chunks(n, CHUNK, |r| ctx.find(r));
             let (fstart, foreign) = foreign_by_first(&found, n);
-            chunks = in_chunks(n, CHUNK, |r| ctx.chunk(r.clone(), &found[r.start / CHUNK], &fstart, &foreign));
-        }
-        let m: usize = chunks.iter().map(|c| c.b.len()).sum();
-        // the list's buffers are reused (the previous b and history too, once
-        // the chunks have read them): no fresh pages on every build
-        let (by_id, (mut b, mut hist)) = match carry {
-            Carry::ByIndex { b, hist, .. } => (None, (b, hist)),
-            Carry::ById(old) => (Some(old), (std::mem::take(&mut self.b), std::mem::take(&mut self.hist))),
-            Carry::None => (None, (std::mem::take(&mut self.b), std::mem::take(&mut self.hist))),
-        };
-        let (a, image) = (&mut self.a, &mut self.image);
-        a.clear();
-        b.clear();
-        image.clear();
-        hist.clear();
-        a.resize(m, 0);
-        let mut at = 0;
-        for c in &chunks {
-            for (k, &cnt) in c.count.iter().enumerate() {
-                a[at..at + cnt as usize].fill((c.lo + k) as u32);
-                at += cnt as usize;
+            // each chunk's pairs, its own and those its particles are first
+            // of but others found, at their places in the list
+            let counts: Vec<usize> =
+                found.iter().enumerate().map(|(c, f)| f.own.len() + (fstart[((c + 1) * CHUNK).min(n)] - fstart[c * CHUNK]) as usize).collect();
+            let m: usize = counts.iter().sum();
+            // the list is written where the list before the last build was
+            // (its history is read by the carry while the chunks write);
+            // every place is written, so only growth needs filling, and
+            // room for a prune's extra history entry
+            let (mut b, mut hist) = std::mem::take(&mut self.spare);
+            let (a, image) = (&mut self.a, &mut self.image);
+            for v in [&mut *a, &mut b] {
+                v.truncate(m);
+                v.resize(m, 0);
             }
-            b.extend_from_slice(&c.b);
-            image.extend_from_slice(&c.image);
-            hist.extend_from_slice(&c.hist);
+            image.truncate(m);
+            image.resize(m, 0);
+            hist.truncate(m * width);
+            hist.reserve((m + 1) * width - hist.len());
+            hist.resize(m * width, 0.0);
+            let mut jobs = Vec::with_capacity(counts.len());
+            let (mut ra, mut rb, mut ri, mut rh) = (&mut a[..], &mut b[..], &mut image[..], &mut hist[..]);
+            for (c, &k) in counts.iter().enumerate() {
+                let (ca, ta) = std::mem::take(&mut ra).split_at_mut(k);
+                let (cb, tb) = std::mem::take(&mut rb).split_at_mut(k);
+                let (ci, ti) = std::mem::take(&mut ri).split_at_mut(k);
+                let (ch, th) = std::mem::take(&mut rh).split_at_mut(k * width);
+                (ra, rb, ri, rh) = (ta, tb, ti, th);
+                jobs.push((c, Place { a: ca, b: cb, image: ci, hist: ch }));
+            }
+            let write = |(c, out): (usize, Place<'_>)| ctx.chunk(c * CHUNK..((c + 1) * CHUNK).min(n), &found[c], &fstart, &foreign, out);
+            if jobs.len() > 1 {
+                jobs.into_par_iter().for_each(write);
+            } else {
+                jobs.into_iter().for_each(write);
+            }
+            built = Some((b, hist));
         }
+        let m = self.a.len();
+        // the buffers the list before wrote its pairs' partners and history
+        // in: the next build's
+        let (by_id, old_b, old_hist) = match carry {
+            Carry::ByIndex { b, hist, .. } => (None, b, hist),
+            Carry::ById(old) => (Some(old), std::mem::take(&mut self.b), std::mem::take(&mut self.hist)),
+            Carry::None => (None, std::mem::take(&mut self.b), std::mem::take(&mut self.hist)),
+        };
+        let (b, mut hist) = built.unwrap_or_else(|| {
+            let (mut b, mut hist) = std::mem::take(&mut self.spare);
+            self.a.clear();
+            self.image.clear();
+            b.clear();
+            hist.clear();
+            (b, hist)
+        });
+        self.spare = (old_b, old_hist);
+        let a = &self.a;
         if let Some(old) = &by_id {
             // storage changed since the last build: match history by id
             // pair, turned where the pair's first particle changed
@@ -1008,6 +1035,9 @@ impl PairList {
     fn live_from_history(&mut self) {
         let w = self.width;
         self.live.clear();
+        // room for the prune's extra flag (a push beyond the capacity would
+        // copy the flags to fresh pages)
+        self.live.reserve(self.a.len() + 1);
         // an OR over each pair's values, not `any`: whether a listed pair has
         // history is a coin toss, and `any`'s early exit a branch on it
         // (1% of the chute's run)
