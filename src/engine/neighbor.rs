@@ -274,6 +274,7 @@ struct Place<'a> {
     a: &'a mut [u32],
     b: &'a mut [u32],
     image: &'a mut [u8],
+    keys: &'a mut [(i64, i64)],
     hist: &'a mut [f64],
 }
 
@@ -396,8 +397,10 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             found.sort_unstable_by(|u, v| u.0.cmp(&v.0).then_with(|| cmp_v3(&self.images[u.1 as usize], &self.images[v.1 as usize])));
             let len = found.len();
             out.a[at..at + len].fill(i as u32);
-            for ((b, image), &(j, img)) in out.b[at..at + len].iter_mut().zip(&mut out.image[at..at + len]).zip(&found) {
-                (*b, *image) = (j, img);
+            let ti = self.p.tag[i];
+            let places = out.b[at..at + len].iter_mut().zip(&mut out.image[at..at + len]).zip(&mut out.keys[at..at + len]);
+            for (((b, image), key), &(j, img)) in places.zip(&found) {
+                (*b, *image, *key) = (j, img, (ti, self.p.tag[j as usize]));
             }
             let h0 = at * w;
             out.hist[h0..h0 + len * w].fill(0.0);
@@ -708,25 +711,28 @@ impl PairList {
             // every place is written, so only growth needs filling, and
             // room for a prune's extra history entry
             let (mut b, mut hist) = std::mem::take(&mut self.spare);
-            let (a, image) = (&mut self.a, &mut self.image);
+            let (a, image, keys) = (&mut self.a, &mut self.image, &mut self.keys);
             for v in [&mut *a, &mut b] {
                 v.truncate(m);
                 v.resize(m, 0);
             }
             image.truncate(m);
             image.resize(m, 0);
+            keys.truncate(m);
+            keys.resize(m, (0, 0));
             hist.truncate(m * width);
             hist.reserve((m + 1) * width - hist.len());
             hist.resize(m * width, 0.0);
             let mut jobs = Vec::with_capacity(counts.len());
-            let (mut ra, mut rb, mut ri, mut rh) = (&mut a[..], &mut b[..], &mut image[..], &mut hist[..]);
+            let (mut ra, mut rb, mut ri, mut rk, mut rh) = (&mut a[..], &mut b[..], &mut image[..], &mut keys[..], &mut hist[..]);
             for (c, &k) in counts.iter().enumerate() {
                 let (ca, ta) = std::mem::take(&mut ra).split_at_mut(k);
                 let (cb, tb) = std::mem::take(&mut rb).split_at_mut(k);
                 let (ci, ti) = std::mem::take(&mut ri).split_at_mut(k);
+                let (ck, tk) = std::mem::take(&mut rk).split_at_mut(k);
                 let (ch, th) = std::mem::take(&mut rh).split_at_mut(k * width);
-                (ra, rb, ri, rh) = (ta, tb, ti, th);
-                jobs.push((c, Place { a: ca, b: cb, image: ci, hist: ch }));
+                (ra, rb, ri, rk, rh) = (ta, tb, ti, tk, th);
+                jobs.push((c, Place { a: ca, b: cb, image: ci, keys: ck, hist: ch }));
             }
             let write = |(c, out): (usize, Place<'_>)| ctx.chunk(c * CHUNK..((c + 1) * CHUNK).min(n), &found[c], &fstart, &foreign, out);
             if jobs.len() > 1 {
@@ -748,6 +754,7 @@ impl PairList {
             let (mut b, mut hist) = std::mem::take(&mut self.spare);
             self.a.clear();
             self.image.clear();
+            self.keys.clear();
             b.clear();
             hist.clear();
             (b, hist)
@@ -771,8 +778,6 @@ impl PairList {
                 }
             }
         }
-        self.keys.clear();
-        self.keys.extend(a.iter().zip(&b).map(|(&i, &j)| (p.tag[i as usize], p.tag[j as usize])));
         self.b = b;
         self.images = images;
         self.hist = hist;
@@ -1069,12 +1074,15 @@ impl PairList {
             return Carry::None;
         }
         let n = p.len();
+        // a pass over every pair's ids, on the pool's threads (a bool: the
+        // same on any thread count)
         let same = self.keys.len() == self.a.len()
             && self
                 .a
-                .iter()
+                .par_iter()
                 .zip(&self.b)
                 .zip(&self.keys)
+                .with_min_len(CHUNK)
                 .all(|((&i, &j), &key)| (i as usize) < n && (j as usize) < n && (p.tag[i as usize], p.tag[j as usize]) == key);
         if same {
             let mut start = vec![0u32; n + 1];
@@ -1790,5 +1798,53 @@ mod tests {
         pl.build(&p, &dom, &s, 30, &signs, |_, _| 0.0);
         assert_eq!(p.tag[pl.a[0] as usize], 7);
         assert_eq!(pl.hist, vec![1.0, 2.0, 3.0]);
+    }
+
+    /// A pair's history as a function of its ids, for the test below.
+    fn marked(ta: i64, tb: i64) -> [f64; 2] {
+        [ta as f64, (tb * 7 % 11) as f64 + 1.0]
+    }
+
+    #[test]
+    fn chunks_write_their_pairs_in_place_and_carry_history_by_index_and_by_id() {
+        // several build chunks, each writing its range of the list
+        let n = 3 * CHUNK as i64 + 500;
+        let (dom, mut p) = gas_of(&mut lcg(21), n);
+        let s = NeighSettings { skin: 0.1, ..Default::default() };
+        let mut pl = PairList::default();
+        let ids = |pl: &PairList, p: &Particles| -> Vec<(i64, i64)> { (0..pl.len()).map(|k| (p.tag[pl.a[k] as usize], p.tag[pl.b[k] as usize])).collect() };
+        let check = |pl: &PairList, p: &Particles, with_history: bool| {
+            assert!(pl.len() > n as usize, "a sparse gas: {} pairs", pl.len());
+            // pairs by first particle, each after its chunk's predecessors
+            assert!(pl.a.windows(2).all(|w| w[0] <= w[1]));
+            assert!((0..pl.len()).all(|k| pl.a[k] < pl.b[k] || (pl.a[k] == pl.b[k] && pl.image[k] != 13)));
+            assert_eq!(pl.keys, ids(pl, p), "keys are the pairs' ids");
+            for (k, &(ta, tb)) in pl.keys.iter().enumerate() {
+                let want = if with_history { marked(ta, tb) } else { [0.0; 2] };
+                assert_eq!(pl.hist[2 * k..2 * k + 2], want, "pair {k} ({ta}, {tb})");
+            }
+        };
+        pl.build(&p, &dom, &s, 0, &[1.0; 2], |_, _| 0.0);
+        check(&pl, &p, false);
+        let first = pl.keys.clone();
+        for (k, &(ta, tb)) in first.iter().enumerate() {
+            pl.hist[2 * k..2 * k + 2].copy_from_slice(&marked(ta, tb));
+        }
+        // storage unchanged: by index, into the spare buffers
+        pl.build(&p, &dom, &s, 5, &[1.0; 2], |_, _| 0.0);
+        assert_eq!(pl.keys, first);
+        check(&pl, &p, true);
+        // and again, into the first build's buffers
+        pl.build(&p, &dom, &s, 10, &[1.0; 2], |_, _| 0.0);
+        check(&pl, &p, true);
+        // storage reversed: by id; every pair's roles swap, and the signs
+        // (1, 1) keep the values
+        let rev: Vec<usize> = (0..p.len()).rev().collect();
+        p.permute(&rev);
+        pl.build(&p, &dom, &s, 20, &[1.0; 2], |_, _| 0.0);
+        assert_eq!(pl.len(), first.len());
+        for (k, &(ta, tb)) in pl.keys.iter().enumerate() {
+            assert_eq!(pl.hist[2 * k..2 * k + 2], marked(tb, ta), "pair {k} ({ta}, {tb}) after the reversal");
+        }
     }
 }
