@@ -379,10 +379,11 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
         out
     }
 
-    /// The list's part for the particles of `range`: each one's pairs
-    /// (those it found itself, in `found_own`, and those later particles
-    /// found, in `foreign` from `fstart`) in order of storage index and
-    /// shift, with the history each carries.
+    /// The list's part for the particles of `range`, written into `out`
+    /// (its range of the list, as many places as the chunk's pairs): each
+    /// one's pairs (those it found itself, in `found_own`, and those later
+    /// particles found, in `foreign` from `fstart`) in order of storage
+    /// index and shift, with their ids and the history each carries.
     fn chunk(&self, range: std::ops::Range<usize>, found_own: &Found, fstart: &[u32], foreign: &[(u32, u8)], out: Place<'_>) {
         let w = self.width;
         // the next pair's place
@@ -1814,7 +1815,7 @@ mod tests {
         let mut pl = PairList::default();
         let ids = |pl: &PairList, p: &Particles| -> Vec<(i64, i64)> { (0..pl.len()).map(|k| (p.tag[pl.a[k] as usize], p.tag[pl.b[k] as usize])).collect() };
         let check = |pl: &PairList, p: &Particles, with_history: bool| {
-            assert!(pl.len() > n as usize, "a sparse gas: {} pairs", pl.len());
+            assert!(pl.len() > n as usize, "more pairs than particles: {}", pl.len());
             // pairs by first particle, each after its chunk's predecessors
             assert!(pl.a.windows(2).all(|w| w[0] <= w[1]));
             assert!((0..pl.len()).all(|k| pl.a[k] < pl.b[k] || (pl.a[k] == pl.b[k] && pl.image[k] != 13)));
