@@ -743,7 +743,6 @@ impl PairList {
             }
             built = Some((b, hist));
         }
-        let m = self.a.len();
         // the buffers the list before wrote its pairs' partners and history
         // in: the next build's
         let (by_id, old_b, old_hist) = match carry {
@@ -761,6 +760,8 @@ impl PairList {
             (b, hist)
         });
         self.spare = (old_b, old_hist);
+        // the new list's pairs (none when no particle is left)
+        let m = self.a.len();
         let a = &self.a;
         if let Some(old) = &by_id {
             // storage changed since the last build: match history by id
@@ -1838,6 +1839,12 @@ mod tests {
         // and again, into the first build's buffers
         pl.build(&p, &dom, &s, 10, &[1.0; 2], |_, _| 0.0);
         check(&pl, &p, true);
+        // every particle gone (a run that lost them all): an empty list
+        let mut none = p.clone();
+        none.remove_where(&vec![true; none.len()]);
+        let mut emptied = pl.clone();
+        emptied.build(&none, &dom, &s, 15, &[1.0; 2], |_, _| 0.0);
+        assert_eq!((emptied.len(), emptied.keys.len(), emptied.hist.len()), (0, 0, 0));
         // storage reversed: by id; every pair's roles swap, and the signs
         // (1, 1) keep the values
         let rev: Vec<usize> = (0..p.len()).rev().collect();
