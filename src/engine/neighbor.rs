@@ -707,23 +707,8 @@ impl PairList {
             let counts: Vec<usize> =
                 found.iter().enumerate().map(|(c, f)| f.own.len() + (fstart[((c + 1) * CHUNK).min(n)] - fstart[c * CHUNK]) as usize).collect();
             let m: usize = counts.iter().sum();
-            // the list is written where the list before the last build was
-            // (its history is read by the carry while the chunks write);
-            // every place is written, so only growth needs filling, and
-            // room for a prune's extra history entry
-            let (mut b, mut hist) = std::mem::take(&mut self.spare);
+            let (mut b, mut hist) = self.places(m, width);
             let (a, image, keys) = (&mut self.a, &mut self.image, &mut self.keys);
-            for v in [&mut *a, &mut b] {
-                v.truncate(m);
-                v.resize(m, 0);
-            }
-            image.truncate(m);
-            image.resize(m, 0);
-            keys.truncate(m);
-            keys.resize(m, (0, 0));
-            hist.truncate(m * width);
-            hist.reserve((m + 1) * width - hist.len());
-            hist.resize(m * width, 0.0);
             let mut jobs = Vec::with_capacity(counts.len());
             let (mut ra, mut rb, mut ri, mut rk, mut rh) = (&mut a[..], &mut b[..], &mut image[..], &mut keys[..], &mut hist[..]);
             for (c, &k) in counts.iter().enumerate() {
@@ -750,15 +735,7 @@ impl PairList {
             Carry::ById(old) => (Some(old), std::mem::take(&mut self.b), std::mem::take(&mut self.hist)),
             Carry::None => (None, std::mem::take(&mut self.b), std::mem::take(&mut self.hist)),
         };
-        let (b, mut hist) = built.unwrap_or_else(|| {
-            let (mut b, mut hist) = std::mem::take(&mut self.spare);
-            self.a.clear();
-            self.image.clear();
-            self.keys.clear();
-            b.clear();
-            hist.clear();
-            (b, hist)
-        });
+        let (b, mut hist) = built.unwrap_or_else(|| self.places(0, width));
         self.spare = (old_b, old_hist);
         // the new list's pairs (none when no particle is left)
         let m = self.a.len();
@@ -789,6 +766,29 @@ impl PairList {
         self.index(n);
         self.last_build = step;
         self.builds += 1;
+    }
+
+    /// The list's arrays sized for `m` pairs of `width` history values, to
+    /// be written by a build: `a`, `image` and `keys` in place, and the
+    /// second particles and history (returned) in the spare buffers, those
+    /// of the list before the last build (the last one's history is read
+    /// by the carry while the build writes). Every place is written, so
+    /// only growth is filled; the history keeps room for a prune's extra
+    /// entry.
+    fn places(&mut self, m: usize, width: usize) -> (Vec<u32>, Vec<f64>) {
+        fn sized<T: Clone>(v: &mut Vec<T>, m: usize, fill: T) {
+            v.truncate(m);
+            v.resize(m, fill);
+        }
+        let (mut b, mut hist) = std::mem::take(&mut self.spare);
+        sized(&mut self.a, m, 0);
+        sized(&mut b, m, 0);
+        sized(&mut self.image, m, 0);
+        sized(&mut self.keys, m, (0, 0));
+        hist.truncate(m * width);
+        hist.reserve((m + 1) * width - hist.len());
+        sized(&mut hist, m * width, 0.0);
+        (b, hist)
     }
 
     /// The buffer for a prune at `step`: twice what the fastest particle
