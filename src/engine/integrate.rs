@@ -14,6 +14,14 @@ pub const INERTIA: f64 = 0.4;
 /// two chunks the loop runs inline (rayon's fork costs more than it saves).
 pub const CHUNK: usize = 4096;
 
+/// The first `k` entries of `rest`, which keeps the others: cut in turn,
+/// a slice gives its consecutive parts to jobs that each write their own.
+pub fn cut<'a, T>(rest: &mut &'a mut [T], k: usize) -> &'a mut [T] {
+    let (head, tail) = std::mem::take(rest).split_at_mut(k);
+    *rest = tail;
+    head
+}
+
 /// `job` over `0..n` in fixed chunks of `chunk`, in parallel when there are
 /// several; the results in chunk order. The chunks never depend on the
 /// thread count, so neither does anything combined from them in order.

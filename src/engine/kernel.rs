@@ -15,6 +15,7 @@
 //! increasing pair index. The order of additions is fixed by the blocks, never
 //! by the threads, so results are bitwise identical on any thread count.
 
+use super::integrate::cut;
 use super::neighbor::PairList;
 #[cfg(doc)]
 use super::neighbor::BLOCK;
@@ -415,15 +416,9 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         let (mut frest, mut trest) = (&mut force.f[..n], &mut force.torque[..n]);
         for q in 0..nblocks {
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
-            let (h, hr) = std::mem::take(&mut hrest).split_at_mut((pe - ps) * w);
-            let (d, dr) = std::mem::take(&mut drest).split_at_mut((block_cross[q + 1] - block_cross[q]) as usize);
-            let (lv, lr) = std::mem::take(&mut lrest).split_at_mut(pe - ps);
-            lrest = lr;
             let len = bs.min(n - (q * bs).min(n));
-            let (f, fr) = std::mem::take(&mut frest).split_at_mut(len);
-            let (tq, tr) = std::mem::take(&mut trest).split_at_mut(len);
-            (hrest, drest, frest, trest) = (hr, dr, fr, tr);
-            jobs.push((q, h, d, lv, f, tq));
+            let (h, d) = (cut(&mut hrest, (pe - ps) * w), cut(&mut drest, (block_cross[q + 1] - block_cross[q]) as usize));
+            jobs.push((q, h, d, cut(&mut lrest, pe - ps), cut(&mut frest, len), cut(&mut trest, len)));
         }
         // particles beyond the blocks (none while the list is indexed for n)
         frest.fill(V3::zeros());

@@ -21,7 +21,7 @@
 //! in the same order.
 
 use super::domain::Domain;
-use super::integrate::{in_chunks, CHUNK};
+use super::integrate::{cut, in_chunks, CHUNK};
 use super::particles::Particles;
 use crate::physics::V3;
 use rayon::prelude::*;
@@ -712,13 +712,8 @@ impl PairList {
             let mut jobs = Vec::with_capacity(counts.len());
             let (mut ra, mut rb, mut ri, mut rk, mut rh) = (&mut a[..], &mut b[..], &mut image[..], &mut keys[..], &mut hist[..]);
             for (c, &k) in counts.iter().enumerate() {
-                let (ca, ta) = std::mem::take(&mut ra).split_at_mut(k);
-                let (cb, tb) = std::mem::take(&mut rb).split_at_mut(k);
-                let (ci, ti) = std::mem::take(&mut ri).split_at_mut(k);
-                let (ck, tk) = std::mem::take(&mut rk).split_at_mut(k);
-                let (ch, th) = std::mem::take(&mut rh).split_at_mut(k * width);
-                (ra, rb, ri, rk, rh) = (ta, tb, ti, tk, th);
-                jobs.push((c, Place { a: ca, b: cb, image: ci, keys: ck, hist: ch }));
+                let (pa, pb, pi, pk) = (cut(&mut ra, k), cut(&mut rb, k), cut(&mut ri, k), cut(&mut rk, k));
+                jobs.push((c, Place { a: pa, b: pb, image: pi, keys: pk, hist: cut(&mut rh, k * width) }));
             }
             let write = |(c, out): (usize, Place<'_>)| ctx.chunk(c * CHUNK..((c + 1) * CHUNK).min(n), &found[c], &fstart, &foreign, out);
             if jobs.len() > 1 {
@@ -985,16 +980,8 @@ impl PairList {
             let (mut ra, mut rb, mut ri, mut rk, mut rl, mut rh) = (&mut na[..], &mut nb[..], &mut ni[..], &mut nk[..], &mut nl[..], &mut nh[..]);
             let mut rs = &mut slot[..];
             for (c, &n) in counts.iter().enumerate() {
-                let (ca, ta) = std::mem::take(&mut ra).split_at_mut(n);
-                let (cb, tb) = std::mem::take(&mut rb).split_at_mut(n);
-                let (ci, ti) = std::mem::take(&mut ri).split_at_mut(n);
-                let (ck, tk) = std::mem::take(&mut rk).split_at_mut(n);
-                let (cl, tl) = std::mem::take(&mut rl).split_at_mut(n);
-                let (ch, th) = std::mem::take(&mut rh).split_at_mut(n * w);
-                let cs_len = PRUNE_CHUNK.min(m - c * PRUNE_CHUNK);
-                let (cs, ts) = std::mem::take(&mut rs).split_at_mut(cs_len);
-                (ra, rb, ri, rk, rl, rh, rs) = (ta, tb, ti, tk, tl, th, ts);
-                jobs.push((c, ca, cb, ci, ck, cl, ch, cs));
+                let slots = cut(&mut rs, PRUNE_CHUNK.min(m - c * PRUNE_CHUNK));
+                jobs.push((c, cut(&mut ra, n), cut(&mut rb, n), cut(&mut ri, n), cut(&mut rk, n), cut(&mut rl, n), cut(&mut rh, n * w), slots));
             }
         }
         let offsets: Vec<usize> = counts.iter().scan(0, |o, &n| Some(std::mem::replace(o, *o + n))).collect();
