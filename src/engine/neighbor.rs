@@ -284,6 +284,9 @@ struct BuildCtx<'a, F> {
     s: &'a NeighSettings,
     grid: &'a Grid,
     images: &'a [V3],
+    /// Each image's rank in the order of its shift ([`cmp_v3`]; equal
+    /// shifts, equal ranks): a pair's sort key with its partner.
+    image_rank: [u8; 27],
     extra_range: &'a F,
     old: &'a Carry,
     width: usize,
@@ -394,8 +397,11 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             found.clear();
             found.extend_from_slice(&found_own.own[found_own.start[k] as usize..found_own.start[k + 1] as usize]);
             found.extend_from_slice(&foreign[fstart[i] as usize..fstart[i + 1] as usize]);
-            // by storage index, then shift (periodic images of one pair)
-            found.sort_unstable_by(|u, v| u.0.cmp(&v.0).then_with(|| cmp_v3(&self.images[u.1 as usize], &self.images[v.1 as usize])));
+            // by storage index, then shift (periodic images of one pair):
+            // one integer key, which compares as the shifts do, so the
+            // sort makes the same moves as one comparing the vectors
+            let rank = &self.image_rank;
+            found.sort_unstable_by_key(|&(j, img)| (j as u64) << 8 | rank[img as usize] as u64);
             let len = found.len();
             out.a[at..at + len].fill(i as u32);
             let ti = self.p.tag[i];
@@ -699,7 +705,8 @@ impl PairList {
             let emax = rep.iter().flat_map(|&(_, i)| rep.iter().map(move |&(_, j)| (i, j))).map(|(i, j)| extra_range(i, j)).fold(0.0, f64::max);
             let grid = Grid::new(p, dom, 2.0 * rmax + s.skin + emax);
             let per_particle = listed / self.x_built.len().max(1);
-            let ctx = BuildCtx { p, s, grid: &grid, images: &images, extra_range: &extra_range, old: &carry, width, per_particle };
+            let image_rank = image_ranks(&images);
+            let ctx = BuildCtx { p, s, grid: &grid, images: &images, image_rank, extra_range: &extra_range, old: &carry, width, per_particle };
             let found = in_chunks(n, CHUNK, |r| ctx.find(r));
             let (fstart, foreign) = foreign_by_first(&found, n);
             // each chunk's pairs, its own and those its particles are first
@@ -1322,6 +1329,30 @@ pub fn spatial_order(p: &Particles, bin: f64) -> Vec<usize> {
     keys.into_iter().map(|(_, i)| i).collect()
 }
 
+/// `k.rem_euclid(n)` (`n > 0`) without the division where `k` is within
+/// the box or one box out, as nearly every particle's bin is: the grid
+/// bins each particle twice a build, and the remainder's division was most
+/// of that.
+#[inline]
+fn wrap_bin(k: i64, n: i64) -> i64 {
+    if (0..n).contains(&k) {
+        k
+    } else if (-n..0).contains(&k) {
+        k + n
+    } else if (n..2 * n).contains(&k) {
+        k - n
+    } else {
+        k.rem_euclid(n)
+    }
+}
+
+/// Each image's rank in the order [`cmp_v3`] gives their shifts (the
+/// number of shifts below it; equal shifts, equal ranks), so that
+/// `(partner, rank)` compares as `(partner, shift)` does.
+fn image_ranks(images: &[V3]) -> [u8; 27] {
+    std::array::from_fn(|k| images.get(k).map_or(0, |v| images.iter().filter(|m| cmp_v3(m, v).is_lt()).count() as u8))
+}
+
 fn cmp_v3(a: &V3, b: &V3) -> std::cmp::Ordering {
     for d in 0..3 {
         match a[d].partial_cmp(&b[d]) {
@@ -1426,7 +1457,7 @@ impl Grid {
         for d in 0..3 {
             let mut k = ((x[d] - self.lo[d]) / self.size[d]).floor() as i64;
             if self.periodic[d] {
-                k = k.rem_euclid(self.dims[d]);
+                k = wrap_bin(k, self.dims[d]);
             } else {
                 k = k.clamp(0, self.dims[d] - 1);
             }
@@ -1499,6 +1530,47 @@ mod tests {
             }
         }
         false
+    }
+
+    /// The bin wrap agrees with the remainder everywhere, in the box, one
+    /// box out and far out (it fails if a branch is off by one).
+    #[test]
+    fn wrap_bin_is_the_remainder() {
+        for n in [1i64, 2, 3, 7, 64] {
+            for k in -5 * n - 3..5 * n + 3 {
+                assert_eq!(wrap_bin(k, n), k.rem_euclid(n), "k {k} n {n}");
+            }
+        }
+        assert_eq!(wrap_bin(i64::MIN + 1, 5), (i64::MIN + 1).rem_euclid(5));
+    }
+
+    /// Sorting by (partner, image rank) moves exactly as sorting by
+    /// (partner, shift) with the vectors compared: the same order for every
+    /// list, duplicate shifts (a zero box length) among the images.
+    #[test]
+    fn image_rank_orders_as_the_shifts() {
+        let l = [2.0, 3.0, 0.0];
+        let images: Vec<V3> =
+            (0..27).map(|c: i64| V3::new((c % 3 - 1) as f64 * l[0], ((c / 3) % 3 - 1) as f64 * l[1], (c / 9 - 1) as f64 * l[2])).collect();
+        let rank = image_ranks(&images);
+        for u in 0..27 {
+            for v in 0..27 {
+                assert_eq!(rank[u].cmp(&rank[v]), cmp_v3(&images[u], &images[v]), "images {u} {v}");
+            }
+        }
+        let mut rng = 12345u64;
+        let mut next = |m: u64| {
+            rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (rng >> 33) % m
+        };
+        for _ in 0..200 {
+            let list: Vec<(u32, u8)> = (0..next(9)).map(|_| (next(4) as u32, next(27) as u8)).collect();
+            let mut by_vectors = list.clone();
+            by_vectors.sort_unstable_by(|u, v| u.0.cmp(&v.0).then_with(|| cmp_v3(&images[u.1 as usize], &images[v.1 as usize])));
+            let mut by_key = list;
+            by_key.sort_unstable_by_key(|&(j, img)| (j as u64) << 8 | rank[img as usize] as u64);
+            assert_eq!(by_key, by_vectors);
+        }
     }
 
     /// Brute-force all (i, j, image) pairs within reach.
