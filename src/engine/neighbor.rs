@@ -400,8 +400,7 @@ impl<F: Fn(usize, usize) -> f64> BuildCtx<'_, F> {
             // by storage index, then shift (periodic images of one pair):
             // one integer key, which compares as the shifts do, so the
             // sort makes the same moves as one comparing the vectors
-            let rank = &self.image_rank;
-            found.sort_unstable_by_key(|&(j, img)| (j as u64) << 8 | rank[img as usize] as u64);
+            found.sort_unstable_by_key(|&(j, img)| pair_key(j, img, &self.image_rank));
             let len = found.len();
             out.a[at..at + len].fill(i as u32);
             let ti = self.p.tag[i];
@@ -689,8 +688,7 @@ impl PairList {
         self.x_pruned.clear();
         let lens = dom.lengths();
         // the 27 images a cell stencil reaches, indexed by the cell shift
-        let images: Vec<V3> =
-            (0..27).map(|c: i64| V3::new((c % 3 - 1) as f64 * lens[0], ((c / 3) % 3 - 1) as f64 * lens[1], (c / 9 - 1) as f64 * lens[2])).collect();
+        let images = stencil_images(lens);
         let carry = self.carry_source(p, width);
         let mut built = None;
         if n > 0 {
@@ -1346,6 +1344,18 @@ fn wrap_bin(k: i64, n: i64) -> i64 {
     }
 }
 
+/// The 27 shifts a cell stencil reaches in a box of side lengths `lens`,
+/// indexed by the cell offset (x fastest, -1, 0, 1 on each axis).
+fn stencil_images(lens: V3) -> Vec<V3> {
+    (0..27).map(|c: i64| V3::new((c % 3 - 1) as f64 * lens[0], ((c / 3) % 3 - 1) as f64 * lens[1], (c / 9 - 1) as f64 * lens[2])).collect()
+}
+
+/// A found pair's sort key: by partner, then by shift ([`image_ranks`]).
+#[inline]
+fn pair_key(j: u32, img: u8, rank: &[u8; 27]) -> u64 {
+    (j as u64) << 8 | rank[img as usize] as u64
+}
+
 /// Each image's rank in the order [`cmp_v3`] gives their shifts (the
 /// number of shifts below it; equal shifts, equal ranks), so that
 /// `(partner, rank)` compares as `(partner, shift)` does.
@@ -1549,9 +1559,7 @@ mod tests {
     /// list, duplicate shifts (a zero box length) among the images.
     #[test]
     fn image_rank_orders_as_the_shifts() {
-        let l = [2.0, 3.0, 0.0];
-        let images: Vec<V3> =
-            (0..27).map(|c: i64| V3::new((c % 3 - 1) as f64 * l[0], ((c / 3) % 3 - 1) as f64 * l[1], (c / 9 - 1) as f64 * l[2])).collect();
+        let images = stencil_images(V3::new(2.0, 3.0, 0.0));
         let rank = image_ranks(&images);
         for u in 0..27 {
             for v in 0..27 {
@@ -1568,7 +1576,7 @@ mod tests {
             let mut by_vectors = list.clone();
             by_vectors.sort_unstable_by(|u, v| u.0.cmp(&v.0).then_with(|| cmp_v3(&images[u.1 as usize], &images[v.1 as usize])));
             let mut by_key = list;
-            by_key.sort_unstable_by_key(|&(j, img)| (j as u64) << 8 | rank[img as usize] as u64);
+            by_key.sort_unstable_by_key(|&(j, img)| pair_key(j, img, &rank));
             assert_eq!(by_key, by_vectors);
         }
     }
