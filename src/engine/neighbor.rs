@@ -308,8 +308,7 @@ struct Found {
     foreign: Vec<(u32, u32, u8)>,
 }
 
-/// The image index of the opposite shift (`images[c]` is
-/// `(c % 3 - 1, c / 3 % 3 - 1, c / 9 - 1)` times the box lengths).
+/// The image index of the opposite shift (of [`stencil_images`]).
 const fn opposite(img: u8) -> u8 {
     26 - img
 }
@@ -686,9 +685,7 @@ impl PairList {
         let listed = self.listed();
         self.outer = None;
         self.x_pruned.clear();
-        let lens = dom.lengths();
-        // the 27 images a cell stencil reaches, indexed by the cell shift
-        let images = stencil_images(lens);
+        let images = stencil_images(dom.lengths());
         let carry = self.carry_source(p, width);
         let mut built = None;
         if n > 0 {
