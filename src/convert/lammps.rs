@@ -350,6 +350,32 @@ fn wall_coeffs(ctx: &mut Ctx, m: &Model3, t: usize) -> Option<String> {
     Some(format!("granular {}", granular_coeffs(ctx, m, 1, t, true)?))
 }
 
+/// Remember the force style of a classic LAMMPS `pair_style gran/hooke`,
+/// `gran/hooke/history` or `gran/hertz/history` (any other pair style
+/// forgets it), for the 2012-era walls after it ([`legacy_wall_to_lammps`]).
+pub fn note_classic_style(ctx: &mut Ctx, w: &[String]) {
+    ctx.legacy_wall_style = w.get(1).and_then(|s| s.strip_prefix("gran/")).filter(|s| matches!(*s, "hooke" | "hooke/history" | "hertz/history")).map(str::to_string);
+}
+
+/// 2012-era LAMMPS `fix ID G wall/gran Kn Kt gn gt xmu dampflag wallstyle
+/// ...`, whose force style was the pair style's, -> the current form with
+/// that style written after `wall/gran` (LAMMPS 29 Sep 2021 rejects the old
+/// form: "Invalid fix wall/gran interaction style"). None for the other
+/// forms.
+pub fn legacy_wall_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
+    if w.get(3).map(|s| s.as_str()) != Some("wall/gran") || !is_number(w.get(4)?) {
+        return None;
+    }
+    let Some(style) = ctx.legacy_wall_style.clone() else {
+        ctx.note(Severity::Approx, "fix wall/gran without a force style and no pair_style gran/* before it: LAMMPS 29 Sep 2021 needs the style (hooke, hooke/history or hertz/history) after wall/gran".into());
+        return Some(Action::Keep);
+    };
+    ctx.note(Severity::Info, format!("2012-era fix wall/gran: the pair style's force style ({style}) written out"));
+    let mut v: Vec<&str> = w.iter().map(String::as_str).collect();
+    v.insert(4, &style);
+    Some(Action::Replace(vec![v.join(" ")]))
+}
+
 /// 3.x `fix ID G wall/gran model ... primitive type T geom args` -> LAMMPS.
 pub fn wall_to_lammps(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     if w.get(3).map(|s| s.as_str()) != Some("wall/gran") || w.get(4).map(|s| s.as_str()) != Some("model") {

@@ -108,6 +108,9 @@ pub struct Ctx<'a> {
     pair_dropped: bool,
     granular: bool,
     liggghts_walls: Option<(String, String)>,
+    /// The force style a 2012-era LAMMPS `fix wall/gran` (coefficients
+    /// first, no style) takes from the classic `pair_style gran/*` before it.
+    pub legacy_wall_style: Option<String>,
     /// Words of every logical line of the deck, and the index of the line
     /// being converted (rules that need the commands that follow, e.g. the
     /// runs an insertion fix stays active for).
@@ -147,6 +150,7 @@ impl<'a> Ctx<'a> {
             pair_dropped: false,
             granular: false,
             liggghts_walls: None,
+            legacy_wall_style: None,
         }
     }
     /// Add a note to the current line.
@@ -301,7 +305,10 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
                 Some(Action::Replace(vec![format!("comm_modify {}", w[1..].iter().filter(|x| *x != "single").cloned().collect::<Vec<_>>().join(" "))]))
             }
         }
-        "pair_style" => lammps::pair_style_to_lammps(ctx, w),
+        "pair_style" => {
+            lammps::note_classic_style(ctx, w);
+            lammps::pair_style_to_lammps(ctx, w)
+        }
         "pair_coeff" => lammps::pair_coeff_to_lammps(ctx, w),
         "compute_modify" if w.iter().any(|x| x == "dynamic") => Some(Action::Replace(vec![w.iter().map(|x| if x == "dynamic" { "dynamic/dof" } else { x.as_str() }).collect::<Vec<_>>().join(" ")])),
         "dump" if w.get(3).map(|s| s.as_str()) == Some("custom") && w.iter().skip(6).any(|x| refs_dropped(ctx, x)) => {
@@ -343,7 +350,7 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
                         Some(Action::Drop(format!("property/global {name} has no LAMMPS counterpart"), Severity::Dropped))
                     }
                 }
-                "wall/gran" => lammps::wall_to_lammps(ctx, w),
+                "wall/gran" => lammps::legacy_wall_to_lammps(ctx, w).or_else(|| lammps::wall_to_lammps(ctx, w)),
                 "insert/pack" | "insert/rate/region" if ctx.facts.gravity.is_none() => Some(Action::Drop("LAMMPS fix pour (the only insertion fix) needs fix gravity".into(), Severity::Dropped)),
                 "insert/pack" | "insert/rate/region" => lammps::insert_to_pour(ctx, w),
                 "pour" | "pour/legacy" => lammps::pour_to_lammps(ctx, w),
