@@ -107,3 +107,21 @@ fn pour_needs_gravity_and_region() {
         assert!(String::from_utf8_lossy(&out.stderr).contains(want), "{}", String::from_utf8_lossy(&out.stderr));
     }
 }
+
+/// The 2012-era `diam lo hi` of fix pour (LAMMPS 29 Sep 2021 takes `diam
+/// one|range|poly`) is a deck error pointing at the word, with a hint to the
+/// current form and to `demx convert`.
+#[test]
+fn pour_old_diam_form_gets_a_hint() {
+    let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+    let base = std::fs::read_to_string(deck("in.pour_small")).unwrap();
+    let edit = base.replace(" region slab", " diam 0.5 1.0 region slab");
+    assert_ne!(edit, base);
+    let p = dir.path().join("in.bad");
+    std::fs::write(&p, edit).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_demx")).arg("check").arg(&p).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("unknown diam style '0.5'"), "{err}");
+    assert!(err.contains("`diam range lo hi`") && err.contains("demx convert --to lammps"), "{err}");
+}

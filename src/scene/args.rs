@@ -90,10 +90,13 @@ impl<'a> Args<'a> {
             _ => Err(bad_keyword(w, what, &["yes", "no"])),
         }
     }
+    /// The word last read, if any.
+    pub fn prev(&self) -> Option<&'a Word> {
+        self.pos.checked_sub(1).and_then(|k| self.cmd.args().get(k))
+    }
     /// Error at the word just read.
     pub fn err_prev(&self, msg: impl Into<String>) -> Error {
-        let w = self.cmd.args().get(self.pos.saturating_sub(1));
-        Error::deck(w.map(|w| w.span).unwrap_or(self.cmd.span), msg)
+        Error::deck(self.prev().map(|w| w.span).unwrap_or(self.cmd.span), msg)
     }
 }
 

@@ -1813,7 +1813,13 @@ fn parse_pour(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args
                 region = Some((r.clone(), w.span));
             }
             "diam" => {
-                let st = a.choice("diam style", &["one", "range", "poly"])?;
+                let st = a.choice("diam style", &["one", "range", "poly"]).map_err(|e| {
+                    // 2012-era LAMMPS wrote `diam lo hi`
+                    match a.prev().filter(|w| super::args::parse_f64(w).is_ok()) {
+                        Some(_) => e.with_hint("2012-era `diam lo hi` is written `diam range lo hi` in current LAMMPS; `demx convert --to lammps` rewrites old decks"),
+                        None => e,
+                    }
+                })?;
                 diam = match st.text.as_str() {
                     "one" => PourDiam::One(0.5 * a.f64("diameter")?),
                     "range" => PourDiam::Range(0.5 * a.f64("diameter lo")?, 0.5 * a.f64("diameter hi")?),
