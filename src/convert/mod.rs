@@ -110,7 +110,7 @@ pub struct Ctx<'a> {
     liggghts_walls: Option<(String, String)>,
     /// The force style a 2012-era LAMMPS `fix wall/gran` (coefficients
     /// first, no style) takes from the classic `pair_style gran/*` before it.
-    pub legacy_wall_style: Option<String>,
+    legacy_wall_style: Option<String>,
     /// Words of every logical line of the deck, and the index of the line
     /// being converted (rules that need the commands that follow, e.g. the
     /// runs an insertion fix stays active for).

@@ -1815,9 +1815,10 @@ fn parse_pour(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args
             "diam" => {
                 let st = a.choice("diam style", &["one", "range", "poly"]).map_err(|e| {
                     // 2012-era LAMMPS wrote `diam lo hi`
-                    match a.prev().filter(|w| super::args::parse_f64(w).is_ok()) {
-                        Some(_) => e.with_hint("2012-era `diam lo hi` is written `diam range lo hi` in current LAMMPS; `demx convert --to lammps` rewrites old decks"),
-                        None => e,
+                    if a.prev().is_some_and(|w| super::args::parse_f64(w).is_ok()) {
+                        e.with_hint("2012-era `diam lo hi` is written `diam range lo hi` in current LAMMPS; `demx convert --to lammps` rewrites old decks")
+                    } else {
+                        e
                     }
                 })?;
                 diam = match st.text.as_str() {
