@@ -1563,11 +1563,8 @@ mod tests {
                 assert_eq!(rank[u].cmp(&rank[v]), cmp_v3(&images[u], &images[v]), "images {u} {v}");
             }
         }
-        let mut rng = 12345u64;
-        let mut next = |m: u64| {
-            rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (rng >> 33) % m
-        };
+        let mut u = lcg(12345);
+        let mut next = |m: u64| (u() * m as f64) as u64;
         for _ in 0..200 {
             let list: Vec<(u32, u8)> = (0..next(9)).map(|_| (next(4) as u32, next(27) as u8)).collect();
             let mut by_vectors = list.clone();
