@@ -123,6 +123,14 @@ pub trait Fix: Send {
     fn id(&self) -> &str;
     /// The style name as written in the deck.
     fn style(&self) -> &str;
+    /// The region this fix looks up by name at each run's start (as LAMMPS's
+    /// `fix wall/gran/region`).
+    fn region(&self) -> Option<&str> {
+        None
+    }
+    /// The region of [`Fix::region`] was deleted and defined again: use the
+    /// new definition from now on.
+    fn replace_region(&mut self, _region: &crate::geom::Region) {}
     /// Called at the start of every run (after the scene is complete).
     fn setup(&mut self, _sim: &mut Sim) -> Result<()> {
         Ok(())

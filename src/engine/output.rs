@@ -129,6 +129,9 @@ pub struct Thermo {
     pub lost: LostPolicy,
     /// Normalise extensive quantities by atom count.
     pub norm: bool,
+    /// `thermo_modify norm` was given; otherwise `norm` follows the units
+    /// (yes for lj, as LAMMPS's and LIGGGHTS's `Thermo::init`).
+    pub norm_set: bool,
     /// Format of the whole line (`thermo_modify format line`).
     pub format_line: Option<String>,
     /// Per-column formats (`thermo_modify format N fmt`), by 1-based column.
@@ -148,6 +151,7 @@ impl Default for Thermo {
             keywords: ["step", "temp", "epair", "emol", "etotal", "press"].iter().map(|s| s.to_string()).collect(),
             lost: LostPolicy::Error,
             norm: false,
+            norm_set: false,
             format_line: None,
             format_col: vec![],
             format_float: None,
@@ -296,25 +300,20 @@ pub fn thermo_keyword(sim: &Sim, k: &str) -> Option<f64> {
             norm(sim.kinetic_energy(u32::MAX))
         }
         "ke" => {
-            // LAMMPS: ke from the temperature (0 when dof <= 0)
-            let dim = d.map_or(3.0, |d| d.dimension as f64);
-            let dof = dim * n - dim;
-            norm(if dof > 0.0 { 0.5 * dof * sim.boltz * sim.temperature() } else { 0.0 })
+            // LAMMPS `thermo.cpp` compute_ke: T * dof/2 * kB with the dof of
+            // the run's setup, so 0 (or -0, dof < 0) in a run that started
+            // with fewer than two atoms
+            norm(sim.temperature() * 0.5 * sim.temp_dof() * sim.boltz)
         }
         "pe" | "epair" | "emol" | "evdwl" | "ecoul" | "ebond" | "elong" => 0.0,
-        "etotal" => {
-            let dim = d.map_or(3.0, |d| d.dimension as f64);
-            let dof = dim * n - dim;
-            norm(if dof > 0.0 { 0.5 * dof * sim.boltz * sim.temperature() } else { 0.0 })
-        }
+        "etotal" => 0.0 + norm(sim.temperature() * 0.5 * sim.temp_dof() * sim.boltz),
         "press" => {
             let v = d.map_or(0.0, |d| d.volume());
             if v == 0.0 {
                 0.0
             } else {
                 let dim = d.map_or(3.0, |d| d.dimension as f64);
-                let dof = dim * n - dim;
-                (dof.max(0.0) * sim.boltz * sim.temperature() + sim.virial()) / (dim * v)
+                (sim.temp_dof().max(0.0) * sim.boltz * sim.temperature() + sim.virial()) / (dim * v)
             }
         }
         "vol" => d.map_or(0.0, |d| d.volume()),

@@ -97,6 +97,12 @@ pub struct Sim {
     pub step: i64,
     /// Step at the start of the current run (`elapsed`).
     pub run_start: i64,
+    /// Atoms counted for the temperature's degrees of freedom: LAMMPS's
+    /// `compute temp` counts them when a run is set up, so atoms inserted
+    /// during a run do not change its dof (None until the first run's setup).
+    pub dof_natoms: Option<usize>,
+    /// `compute_modify thermo_temp dynamic/dof yes`: count them every time.
+    pub dof_dynamic: bool,
     /// Last step of the current run.
     pub run_end: i64,
     /// `run ... start S stop E` bounds for ramp() and friends.
@@ -157,6 +163,8 @@ impl Default for Sim {
             log: Logger::default(),
             step: 0,
             run_start: 0,
+            dof_natoms: None,
+            dof_dynamic: false,
             run_end: 0,
             run_bounds: None,
             dt: 1e-5,
@@ -438,6 +446,9 @@ impl Sim {
         self.clock = Instant::now();
         self.timing = [0.0; 4];
         self.walked = 0;
+        if pre {
+            self.dof_natoms = Some(self.particles.len());
+        }
         if pre || self.pairs.x_built.len() != self.particles.len() {
             self.setup(vars)?;
         }
@@ -728,11 +739,22 @@ impl Sim {
         (0..p.len()).filter(|&i| p.mask[i] & bit != 0).map(|i| 0.5 * p.inertia(i) * p.omega[i].norm_squared()).sum()
     }
 
-    /// Temperature as LAMMPS `compute temp` (dof = 3N - 3, or 2N - 2 in 2d).
-    pub fn temperature(&self) -> f64 {
-        let n = self.particles.len() as f64;
+    /// Degrees of freedom of LAMMPS's `compute temp`: dim N - dim, N counted
+    /// at the run's setup unless `dynamic/dof` is set (`compute_temp.cpp`
+    /// `dof_compute`, called from `init`/`setup`).
+    pub fn temp_dof(&self) -> f64 {
+        let n = match self.dof_natoms {
+            Some(n) if !self.dof_dynamic => n,
+            _ => self.particles.len(),
+        } as f64;
         let dim = self.domain.as_ref().map_or(3, |d| d.dimension) as f64;
-        let dof = dim * n - dim;
+        dim * n - dim
+    }
+
+    /// Temperature as LAMMPS `compute temp`: sum m v^2 / (dof kB), 0 when
+    /// dof <= 0 ([`Sim::temp_dof`]).
+    pub fn temperature(&self) -> f64 {
+        let dof = self.temp_dof();
         if dof <= 0.0 {
             return 0.0;
         }

@@ -10,6 +10,29 @@ use crate::physics::V3;
 use crate::script::{Command, EvalContext, Variables};
 use std::sync::{Arc, Mutex, PoisonError};
 
+/// A fix that only tunes how MPI ranks share the work (`fix balance`):
+/// kept under its id so that `unfix` and a later fix of the same id find it,
+/// and does nothing in demx, which runs one process with deterministic threads.
+pub struct Noop {
+    /// Id.
+    pub id: String,
+    /// Style as written.
+    pub style: String,
+}
+
+impl Fix for Noop {
+    crate::no_step_hooks!();
+    fn end_of_step_due(&self, _step: i64) -> bool {
+        false
+    }
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn style(&self) -> &str {
+        &self.style
+    }
+}
+
 /// `fix ID group nve/sphere`.
 pub struct NveSphere {
     /// Id.

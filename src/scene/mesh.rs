@@ -596,6 +596,14 @@ impl WallGranRegion {
 
 impl Fix for WallGranRegion {
     crate::post_force_only!();
+    fn region(&self) -> Option<&str> {
+        Some(&self.region.id)
+    }
+    fn replace_region(&mut self, region: &Region) {
+        // LAMMPS resets the wall's motion when its region changed between runs
+        self.region = region.clone();
+        self.prev = None;
+    }
     fn id(&self) -> &str {
         &self.id
     }

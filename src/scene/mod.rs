@@ -71,6 +71,8 @@ pub struct Session {
     pub schedule: Vec<RunRecord>,
     /// Whether the dialect was fixed by a command.
     pub dialect_known: bool,
+    /// Regions deleted (`region ID delete`) since the last run.
+    pub deleted_regions: Vec<String>,
     /// `hard_particles yes` (LIGGGHTS: moduli above 1 GPa allowed).
     pub hard_particles: bool,
     /// `soft_particles yes` (LIGGGHTS: moduli below 5 MPa allowed).
@@ -152,6 +154,8 @@ impl Session {
     pub fn new(check: bool) -> Session {
         let mut sim = Sim::default();
         sim.dry = check;
+        // LAMMPS's default units are lj, whose thermo output is per atom
+        sim.thermo.norm = true;
         Session {
             sim,
             units: Units::Lj,
@@ -165,6 +169,7 @@ impl Session {
             notes: vec![],
             schedule: vec![],
             dialect_known: false,
+            deleted_regions: vec![],
             hard_particles: false,
             soft_particles: false,
             check,
@@ -256,6 +261,18 @@ impl Session {
             "atom_modify" => self.atom_modify(cmd),
             "demx_guard" => self.guard_command(cmd),
             n if NOOP_COMMANDS.contains(&n) => {
+                if n == "compute_modify" {
+                    // `compute_modify ID dynamic/dof yes` (`dynamic` before 2019 and in
+                    // LIGGGHTS): the temperature counts atoms at every use
+                    let w = &cmd.words;
+                    if w.get(1).map_or(false, |id| id.text == "thermo_temp" || self.sim.computes.iter().any(|c| c.id == id.text && c.style == "temp")) {
+                        for k in 2..w.len().saturating_sub(1) {
+                            if matches!(w[k].text.as_str(), "dynamic/dof" | "dynamic") {
+                                self.sim.dof_dynamic = matches!(w[k + 1].text.as_str(), "yes" | "on");
+                            }
+                        }
+                    }
+                }
                 if n == "newton" {
                     let a = Args::new(cmd);
                     if let Some(w) = a.peek() {
@@ -295,11 +312,38 @@ impl Session {
             let gw = a.word("group")?;
             let style = a.word("fix style")?;
             let group = self.group(gw)?;
+            if style.text == "balance" {
+                // LAMMPS `fix ID group balance Nfreq thresh style args ...`: how
+                // MPI ranks share the box, nothing a single process does.
+                a.i64("Nfreq")?;
+                a.f64("thresh")?;
+                a.choice("balance style", &["shift", "rcb"])?;
+                self.notes.push((cmd.span, "fix balance: accepted; changes nothing in demx (single process, deterministic threads)".into()));
+                return self.add_fix(Box::new(fixes::Noop { id: id.text.clone(), style: style.text.clone() }));
+            }
             if let Some(f) = fixes::parse_simple(&self.sim, &id.text, group, &style.text, &mut a, cmd)? {
                 return self.add_fix(f);
             }
             model::fix_command(self, cmd, &id.text, group, style, &mut a, vars)
         }
+    }
+
+    /// Before a run: fixes that look their region up by name (LAMMPS
+    /// `FixWallGranRegion::init`) take the new definition of a region deleted
+    /// since the last run, or stop the run if it was not defined again.
+    fn refresh_regions(&mut self, cmd: &Command) -> Result<()> {
+        for id in std::mem::take(&mut self.deleted_regions) {
+            let new = self.regions.iter().find(|r| r.id == id);
+            for f in self.sim.fixes.iter_mut().filter(|f| f.region() == Some(id.as_str())) {
+                match new {
+                    Some(r) => f.replace_region(r),
+                    None => {
+                        return Err(Error::deck(cmd.words[0].span, format!("fix {} ({}): its region '{id}' was deleted and not defined again", f.id(), f.style())))
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Add (or replace, same id, as LAMMPS does) a fix.
@@ -393,6 +437,7 @@ impl Session {
         }
         self.need_box(cmd)?;
         model::finalize(self, cmd)?;
+        self.refresh_regions(cmd)?;
         if let Some((seed, amp)) = self.perturb.take().filter(|_| !self.check) {
             perturb_positions(&mut self.sim.particles, seed, amp);
         }

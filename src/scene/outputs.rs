@@ -56,7 +56,10 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                             _ => LostPolicy::Ignore,
                         };
                     }
-                    "norm" => s.sim.thermo.norm = a.yes_no("norm")?,
+                    "norm" => {
+                        s.sim.thermo.norm = a.yes_no("norm")?;
+                        s.sim.thermo.norm_set = true;
+                    }
                     "flush" | "line" => {
                         a.word("value")?;
                     }

@@ -29,6 +29,9 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             };
             s.sim.boltz = boltz;
             s.sim.neigh.skin = skin;
+            if !s.sim.thermo.norm_set {
+                s.sim.thermo.norm = s.units == Units::Lj;
+            }
             Ok(())
         }
         "atom_style" => {
@@ -153,6 +156,18 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
         "reset_timestep" => {
             let n = a.i64("step")?;
             s.sim.step = n;
+            Ok(())
+        }
+        "region" if cmd.args().get(1).map_or(false, |w| w.text == "delete") => {
+            // `region ID delete`: later commands may define the ID afresh.
+            // Fixes that took the region (insertion, forces) keep the copy
+            // they took; a wall/gran/region, which LAMMPS looks up by name at
+            // each run's start, takes the new definition then (or stops the
+            // run if there is none): see `Session::refresh_regions`.
+            let w = a.word("region id")?;
+            let k = s.regions.iter().position(|r| r.id == w.text).ok_or_else(|| Error::deck(w.span, format!("region delete: region '{}' does not exist", w.text)))?;
+            s.regions.remove(k);
+            s.deleted_regions.push(w.text.clone());
             Ok(())
         }
         "region" => {
@@ -757,7 +772,7 @@ const ENGINE_FIX_STYLES: &[&str] = &[
     "heat/gran", "heat/gran/conduction", "multisphere", "particletemplate/multisphere", "particletemplate/superquadric",
     "massflow/mesh", "ave/euler", "property/atom/tracer", "property/atom/tracer/stream", "wall/region/sph", "insert/pack/dense",
     "nve/sphere/omp", "ave/chunk", "ave/atom", "ave/histo", "ave/correlate", "deform", "rigid", "rigid/small", "spring", "langevin",
-    "nvt", "npt", "nph", "wall/reflect", "wall/region", "store/state", "heat/flow", "temp/rescale", "balance", "dt/reset", "adapt",
+    "nvt", "npt", "nph", "wall/reflect", "wall/region", "store/state", "heat/flow", "temp/rescale", "dt/reset", "adapt",
     "python/invoke", "wiggle/mesh", "mesh/gran", "recenter", "setforce/region", "lineforce", "planeforce", "efield", "wall/lj93",
     "nve/limit", "nve/asphere", "bond/create", "bond/break", "wall/gran/hertz/history", "wall/gran/hooke/history", "wall/gran/hooke",
     "pour/legacy", "pour/dev", "move/mesh/gran", "heat/radiation", "nve/superquadric", "particledistribution/discrete/numberbased",
