@@ -15,6 +15,17 @@
 //!   and after the last one (so a multiple of 9 leaves an empty line).
 //! - LIGGGHTS orders the arrays in an order of its own; demx writes them in
 //!   column order (readers look arrays up by name).
+//! - Positions are the points whether or not x y z are among the columns.
+//! - Three columns `<p>[k] <p>[k+1] <p>[k+2]` (a compute's or fix's per-atom
+//!   vector) become one array `<p>[k-(k+2)]`, as `c_d[1-3]`.
+//! - A file name ending in `.vtp` or `.vtu` gets VTK's XML PolyData or
+//!   UnstructuredGrid in ASCII (tests/data/io/lig_xml_*): numbers as VTK 9.1's
+//!   `vtkNumberToString` writes them ([`fmt_vtk_xml`]), six values a line,
+//!   points as `Float32`, each array's `RangeMin`/`RangeMax` (of the L2 norms
+//!   for vectors, which also get an `L2_NORM_RANGE` key at 11 digits), vertex
+//!   cells; the box beside them as a `.vtr` rectilinear grid. VTK names the
+//!   grid's coordinate arrays after their memory address; demx names them
+//!   `x`, `y`, `z`.
 //! - STL: `solid LIGGGHTS_STL_EXPORT`, facet normal (v1-v0)x(v2-v1)
 //!   normalised, numbers with `%g`.
 
@@ -53,6 +64,15 @@ pub fn vtk_fields(columns: &[String]) -> Result<([usize; 3], Vec<VtkField>)> {
             continue;
         }
         let c = &columns[j];
+        if let Some((p, k)) = indexed(c) {
+            if j + 2 < columns.len() && columns[j + 1] == format!("{p}[{}]", k + 1) && columns[j + 2] == format!("{p}[{}]", k + 2) {
+                used[j] = true;
+                used[j + 1] = true;
+                used[j + 2] = true;
+                out.push(VtkField { name: format!("{p}[{k}-{}]", k + 2), cols: vec![j, j + 1, j + 2], int: false });
+                continue;
+            }
+        }
         if let Some(p) = c.strip_suffix('x') {
             if !p.is_empty() && j + 2 < columns.len() && columns[j + 1] == format!("{p}y") && columns[j + 2] == format!("{p}z")
             {
@@ -67,6 +87,12 @@ pub fn vtk_fields(columns: &[String]) -> Result<([usize; 3], Vec<VtkField>)> {
         out.push(VtkField { name: c.clone(), cols: vec![j], int: is_int_column(c) });
     }
     Ok((pts, out))
+}
+
+/// `c_d[2]` -> (`c_d`, 2).
+fn indexed(c: &str) -> Option<(&str, usize)> {
+    let (p, rest) = c.split_once('[')?;
+    Some((p, rest.strip_suffix(']')?.parse().ok()?))
 }
 
 fn push_values(o: &mut String, vals: impl Iterator<Item = String>) {
@@ -121,11 +147,152 @@ pub fn format_particles_vtk(frame: &Frame) -> Result<String> {
     Ok(o)
 }
 
-/// Write one frame as a particle VTK file.
+/// Which VTK file a `dump custom/vtk` file name asks for (by its extension,
+/// as LIGGGHTS chooses its writer).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VtkFormat {
+    /// Legacy ASCII `.vtk` (any other extension).
+    Legacy,
+    /// XML PolyData, `.vtp`.
+    PolyData,
+    /// XML UnstructuredGrid, `.vtu`.
+    UnstructuredGrid,
+}
+
+impl VtkFormat {
+    /// The format of a file name.
+    pub fn of(path: &str) -> VtkFormat {
+        if path.ends_with(".vtp") {
+            VtkFormat::PolyData
+        } else if path.ends_with(".vtu") {
+            VtkFormat::UnstructuredGrid
+        } else {
+            VtkFormat::Legacy
+        }
+    }
+}
+
+/// Write one frame as a particle VTK file in the format its name asks for,
+/// through a temporary file renamed into place.
 pub fn write_particles_vtk(path: impl AsRef<Path>, frame: &Frame) -> Result<()> {
     let path = path.as_ref();
-    let text = format_particles_vtk(frame)?;
-    std::fs::write(path, text).map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", path.display()), &e))
+    let text = match VtkFormat::of(&path.to_string_lossy()) {
+        VtkFormat::Legacy => format_particles_vtk(frame)?,
+        f => format_particles_vtk_xml(frame, f)?,
+    };
+    crate::io::write_atomic(path, text.as_bytes())
+}
+
+/// A number as VTK 9.1 writes it in XML files (`vtkNumberToString`: the
+/// double-conversion library's ECMAScript form): the shortest digits that read
+/// back to the same double, in fixed notation for 1e-6 <= |x| < 1e21, else as
+/// `d.ddde+N` / `d.ddde-N`; zero (either sign) is `0`.
+pub fn fmt_vtk_xml(x: f64) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() {
+        return if x.is_nan() { "NaN" } else if x > 0.0 { "Infinity" } else { "-Infinity" }.into();
+    }
+    if (1e-6..1e21).contains(&x.abs()) {
+        // Rust prints the shortest round-trip digits without an exponent
+        format!("{x}")
+    } else {
+        let s = format!("{x:e}");
+        match s.split_once('e') {
+            Some((m, e)) if !e.starts_with('-') => format!("{m}e+{e}"),
+            _ => s,
+        }
+    }
+}
+
+/// One `<DataArray>` of an XML VTK file: values six to a line, the range
+/// (of the tuples' L2 norms when there are several components, which also get
+/// VTK's `L2_NORM_RANGE` key), `1e+299`/`-1e+299` when empty.
+fn xml_array(o: &mut String, indent: &str, ty: &str, name: &str, ncomp: usize, vals: &[f64], text: impl Fn(f64) -> String) {
+    let n = if ncomp == 0 { 0 } else { vals.len() / ncomp };
+    let (mut lo, mut hi) = (1e299_f64, -1e299_f64);
+    for t in 0..n {
+        let v = if ncomp == 1 { vals[t] } else { vals[t * ncomp..(t + 1) * ncomp].iter().map(|c| c * c).sum::<f64>().sqrt() };
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    let comps = if ncomp > 1 { format!(" NumberOfComponents=\"{ncomp}\"") } else { String::new() };
+    o.push_str(&format!(
+        "{indent}<DataArray type=\"{ty}\" Name=\"{name}\"{comps} format=\"ascii\" RangeMin=\"{}\" RangeMax=\"{}\">\n",
+        fmt_vtk_xml(lo),
+        fmt_vtk_xml(hi)
+    ));
+    for line in vals.chunks(6) {
+        o.push_str(indent);
+        o.push_str("  ");
+        o.push_str(&line.iter().map(|&v| text(v)).collect::<Vec<_>>().join(" "));
+        o.push('\n');
+    }
+    if ncomp > 1 {
+        o.push_str(&format!("{indent}  <InformationKey name=\"L2_NORM_RANGE\" location=\"vtkDataArray\" length=\"2\">\n"));
+        for (k, v) in [lo, hi].into_iter().enumerate() {
+            o.push_str(&format!("{indent}    <Value index=\"{k}\">\n{indent}      {}\n{indent}    </Value>\n", fmt_g(v, 11)));
+        }
+        o.push_str(&format!("{indent}  </InformationKey>\n"));
+    }
+    o.push_str(&format!("{indent}</DataArray>\n"));
+}
+
+/// Text of a particle file in VTK's XML PolyData (`.vtp`) or
+/// UnstructuredGrid (`.vtu`) form, as LIGGGHTS 3.8 with VTK 9 writes them.
+pub fn format_particles_vtk_xml(frame: &Frame, format: VtkFormat) -> Result<String> {
+    let (pts, fields) = vtk_fields(&frame.columns)?;
+    let n = frame.natoms;
+    let nc = frame.columns.len();
+    if frame.values.len() != n * nc {
+        return Err(Error::usage("VTK frame has a wrong number of values"));
+    }
+    let val = |r: usize, c: usize| frame.values[r * nc + c];
+    let kind = if format == VtkFormat::PolyData { "PolyData" } else { "UnstructuredGrid" };
+    let mut o = format!("<?xml version=\"1.0\"?>\n<VTKFile type=\"{kind}\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n  <{kind}>\n");
+    if format == VtkFormat::PolyData {
+        o.push_str(&format!("    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"));
+    } else {
+        o.push_str(&format!("    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">\n"));
+    }
+    o.push_str("      <PointData>\n");
+    let ind = "        ";
+    for f in &fields {
+        let vals: Vec<f64> = (0..n).flat_map(|r| f.cols.iter().map(move |&c| val(r, c))).collect();
+        if f.int {
+            xml_array(&mut o, ind, "Int32", &f.name, f.cols.len(), &vals, |v| format!("{}", v as i64));
+        } else {
+            xml_array(&mut o, ind, "Float64", &f.name, f.cols.len(), &vals, fmt_vtk_xml);
+        }
+    }
+    o.push_str("      </PointData>\n      <CellData>\n      </CellData>\n      <Points>\n");
+    let points: Vec<f64> = (0..n).flat_map(|r| pts.map(|c| val(r, c) as f32 as f64)).collect();
+    xml_array(&mut o, ind, "Float32", "Points", 3, &points, fmt_vtk_xml);
+    o.push_str("      </Points>\n");
+    let conn: Vec<f64> = (0..n).map(|k| k as f64).collect();
+    let offsets: Vec<f64> = (1..=n).map(|k| k as f64).collect();
+    let int = |v: f64| format!("{}", v as i64);
+    let cells = |o: &mut String, tag: &str, conn: &[f64], offsets: &[f64]| {
+        o.push_str(&format!("      <{tag}>\n"));
+        xml_array(o, ind, "Int64", "connectivity", 1, conn, int);
+        xml_array(o, ind, "Int64", "offsets", 1, offsets, int);
+    };
+    if format == VtkFormat::PolyData {
+        cells(&mut o, "Verts", &conn, &offsets);
+        o.push_str("      </Verts>\n");
+        for tag in ["Lines", "Strips", "Polys"] {
+            cells(&mut o, tag, &[], &[]);
+            o.push_str(&format!("      </{tag}>\n"));
+        }
+    } else {
+        cells(&mut o, "Cells", &conn, &offsets);
+        // VTK_VERTEX
+        xml_array(&mut o, ind, "UInt8", "types", 1, &vec![1.0; n], int);
+        o.push_str("      </Cells>\n");
+    }
+    o.push_str(&format!("    </Piece>\n  </{kind}>\n</VTKFile>\n"));
+    Ok(o)
 }
 
 /// Text of the `*_boundingBox_*.vtk` file LIGGGHTS writes beside particle
@@ -135,6 +302,19 @@ pub fn format_bounding_box_vtk(lo: [f64; 3], hi: [f64; 3]) -> String {
     for (k, n) in ["X", "Y", "Z"].iter().enumerate() {
         o.push_str(&format!("{n}_COORDINATES 2 double\n{} {} \n", fmt_g(lo[k], 11), fmt_g(hi[k], 11)));
     }
+    o
+}
+
+/// Text of the `*_boundingBox_*.vtr` file LIGGGHTS writes beside XML
+/// particle files (a 2x2x2 rectilinear grid).
+pub fn format_bounding_box_vtr(lo: [f64; 3], hi: [f64; 3]) -> String {
+    let mut o = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"RectilinearGrid\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n  <RectilinearGrid WholeExtent=\"0 1 0 1 0 1\">\n  <Piece Extent=\"0 1 0 1 0 1\">\n    <PointData>\n    </PointData>\n    <CellData>\n    </CellData>\n    <Coordinates>\n",
+    );
+    for k in 0..3 {
+        xml_array(&mut o, "      ", "Float64", ["x", "y", "z"][k], 1, &[lo[k], hi[k]], fmt_vtk_xml);
+    }
+    o.push_str("    </Coordinates>\n  </Piece>\n  </RectilinearGrid>\n</VTKFile>\n");
     o
 }
 

@@ -297,9 +297,15 @@ impl Dump for DumpVtk {
         crate::io::vtk::write_particles_vtk(&file, &frame)?;
         if self.path.contains('*') {
             if let Some(d) = &sim.domain {
+                use crate::io::vtk::{format_bounding_box_vtk, format_bounding_box_vtr, VtkFormat};
                 let bb = self.path.replace('*', &format!("boundingBox_{}", sim.step));
-                let text = crate::io::vtk::format_bounding_box_vtk([d.lo[0], d.lo[1], d.lo[2]], [d.hi[0], d.hi[1], d.hi[2]]);
-                std::fs::write(&bb, text).map_err(|e| Error::io(crate::script::Span::DUMMY, format!("cannot write '{bb}'"), &e))?;
+                let (lo, hi) = ([d.lo[0], d.lo[1], d.lo[2]], [d.hi[0], d.hi[1], d.hi[2]]);
+                let (bb, text) = match VtkFormat::of(&bb) {
+                    VtkFormat::Legacy => (bb, format_bounding_box_vtk(lo, hi)),
+                    // beside .vtp and .vtu files, a .vtr
+                    _ => (format!("{}.vtr", &bb[..bb.len() - 4]), format_bounding_box_vtr(lo, hi)),
+                };
+                crate::io::write_atomic(&bb, text.as_bytes())?;
             }
         }
         Ok(())
@@ -510,7 +516,13 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         return Err(Error::deck(id.span, format!("dump '{}' already exists", id.text)).with_hint("undump it first"));
     }
     if style.text == "custom/vtk" {
-        crate::io::vtk::vtk_fields(&columns).map_err(|_| Error::deck(style.span, "dump custom/vtk needs the columns x y z"))?;
+        // the points are the positions whether or not the deck lists them (LIGGGHTS)
+        let mut columns = columns;
+        for c in ["x", "y", "z"] {
+            if !columns.iter().any(|x| x == c) {
+                columns.push(c.to_string());
+            }
+        }
         let d = DumpVtk { id: id.text.clone(), group, columns, every, first: false, path: file.text.clone(), last_step: None, summary };
         s.sim.dumps.push(Box::new(d));
         return Ok(());
