@@ -25,6 +25,13 @@ pub enum ComputeKind {
     },
     /// `com`: centre of mass (vector of 3).
     Com,
+    /// `displace/atom`: each atom's displacement from its original unwrapped
+    /// position (dx, dy, dz, |d|), the originals kept in the particles' extra
+    /// column `column` so that they follow sorting, deletion and restarts.
+    DisplaceAtom {
+        /// Name of the extra per-atom column of originals.
+        column: String,
+    },
     /// A style demx records (for `demx check`) but cannot evaluate.
     Other(String),
 }
@@ -123,6 +130,28 @@ impl Compute {
                 let k = col.unwrap_or(1);
                 let name = names.get(k - 1).ok_or_else(|| format!("compute {} has no column {k}", self.id))?;
                 (0..sim.particles.len()).map(|i| atom_property(sim, name, i).ok_or_else(|| format!("unknown property {name}"))).collect()
+            }
+            ComputeKind::DisplaceAtom { column } => {
+                let k = col.ok_or_else(|| format!("compute {} ({}) has 4 values per atom: use c_{}[1..4]", self.id, self.style, self.id))?;
+                if !(1..=4).contains(&k) {
+                    return Err(format!("compute {} has no column {k} (displace/atom has 4)", self.id));
+                }
+                let p = &sim.particles;
+                let e = p.extra_index(column).map(|e| &p.extra[e]).ok_or_else(|| format!("compute {}: its originals are gone", self.id))?;
+                Ok((0..p.len())
+                    .map(|i| {
+                        if p.mask[i] & self.group == 0 {
+                            return 0.0;
+                        }
+                        let x = unwrapped(sim, i);
+                        let d = [x.x - e.data[3 * i], x.y - e.data[3 * i + 1], x.z - e.data[3 * i + 2]];
+                        if k == 4 {
+                            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+                        } else {
+                            d[k - 1]
+                        }
+                    })
+                    .collect())
             }
             _ => Err(format!("compute {} ({}) has no per-atom values", self.id, self.style)),
         }

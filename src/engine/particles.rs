@@ -17,6 +17,10 @@ pub struct PerAtom {
     pub data: Vec<f64>,
     /// Value new atoms get.
     pub default: Vec<f64>,
+    /// New atoms get their position instead of `default` (width 3: LAMMPS
+    /// `compute displace/atom`'s `set_arrays`, the original of an atom
+    /// created after the compute).
+    pub from_position: bool,
 }
 
 /// All particles, one column per quantity.
@@ -103,7 +107,11 @@ impl Particles {
         self.image.push([0; 3]);
         self.frozen.push(false);
         for e in &mut self.extra {
-            e.data.extend_from_slice(&e.default);
+            if e.from_position {
+                e.data.extend_from_slice(&[p.x.x, p.x.y, p.x.z]);
+            } else {
+                e.data.extend_from_slice(&e.default);
+            }
         }
     }
     /// Remove particle `i` by moving the last one into its place (LAMMPS
@@ -183,7 +191,7 @@ impl Particles {
         for _ in 0..self.len() {
             data.extend_from_slice(&default);
         }
-        self.extra.push(PerAtom { name: name.to_string(), width, data, default });
+        self.extra.push(PerAtom { name: name.to_string(), width, data, default, from_position: false });
         self.extra.len() - 1
     }
     /// Index of an extra column by name.

@@ -438,6 +438,15 @@ impl Session {
         self.need_box(cmd)?;
         model::finalize(self, cmd)?;
         self.refresh_regions(cmd)?;
+        // compute displace/atom: the originals of atoms created from now on
+        // follow the dialect the deck has settled by now
+        for c in &self.sim.computes {
+            if let crate::engine::compute::ComputeKind::DisplaceAtom { column } = &c.kind {
+                if let Some(e) = self.sim.particles.extra_index(column) {
+                    self.sim.particles.extra[e].from_position = self.sim.dialect == crate::engine::Dialect::Lammps;
+                }
+            }
+        }
         if let Some((seed, amp)) = self.perturb.take().filter(|_| !self.check) {
             perturb_positions(&mut self.sim.particles, seed, amp);
         }

@@ -97,6 +97,14 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
         "uncompute" => {
             let w = a.word("compute id")?;
             let before = s.sim.computes.len();
+            if let Some(c) = s.sim.computes.iter().find(|c| c.id == w.text) {
+                if let ComputeKind::DisplaceAtom { column } = &c.kind {
+                    let p = &mut s.sim.particles;
+                    if let Some(e) = p.extra_index(column) {
+                        p.extra.remove(e);
+                    }
+                }
+            }
             s.sim.computes.retain(|c| c.id != w.text);
             if s.sim.computes.len() == before {
                 return Err(Error::deck(w.span, format!("uncompute: compute '{}' does not exist", w.text)));
@@ -172,6 +180,32 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
                 names.push(w.text.clone());
             }
             ComputeKind::PropertyAtom { names }
+        }
+        "displace/atom" => {
+            // Originals: the group's unwrapped positions now, 0 elsewhere (the
+            // compute reports 0 outside its group). Atoms created later get
+            // their position at creation in LAMMPS (`set_arrays`); LIGGGHTS
+            // 3.8 leaves them at 0, so their displacement is their position
+            // (seen in its dumps of the liggghts-inl dump_custom_vtk deck). A
+            // column restored from a restart keeps its originals, as the
+            // engines' fix store does for the same compute id.
+            while a.more() {
+                let k = a.word("displace/atom keyword")?;
+                return Err(Error::unsupported(k.span, format!("compute displace/atom keyword {}", k.text)));
+            }
+            let column = format!("displace/atom:{}", id.text);
+            let fresh = s.sim.particles.extra_index(&column).is_none();
+            let originals: Vec<f64> = (0..s.sim.particles.len())
+                .flat_map(|i| if s.sim.particles.mask[i] & group != 0 { crate::engine::compute::unwrapped(&s.sim, i).into() } else { [0.0; 3] })
+                .collect();
+            let p = &mut s.sim.particles;
+            let e = p.add_extra(&column, vec![0.0; 3]);
+            // the dialect may be settled later in the deck: each run's start sets this again
+            p.extra[e].from_position = s.sim.dialect == crate::engine::Dialect::Lammps;
+            if fresh {
+                p.extra[e].data = originals;
+            }
+            ComputeKind::DisplaceAtom { column }
         }
         other => {
             return Err(Error::unsupported(style.span, format!("compute {other}")));
