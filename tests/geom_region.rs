@@ -223,3 +223,81 @@ fn lattice_units_scale_and_errors() {
     let r = parse_region(&cmd("region b block EDGE 1 0 1 0 1 units box"), &ctx).unwrap();
     assert_eq!(r.bbox().unwrap().0.x, -10.0);
 }
+
+/// The face-by-face answer: every closed face's closest point, the first
+/// nearest of them for side out, each one within `cutoff` for side in.
+fn by_faces(r: &Region, q: V3, cutoff: f64, faces: &[V3], inside: bool) -> Vec<(f64, V3)> {
+    let within = |c: &V3| (q - c).norm() < cutoff && (q - c).norm() > 0.0;
+    if inside {
+        faces.iter().filter(|c| within(c)).map(|c| ((q - c).norm(), *c)).collect()
+    } else {
+        let c = faces.iter().copied().fold(None::<V3>, |b, c| match b {
+            Some(b) if (q - b).norm() <= (q - c).norm() => Some(b),
+            _ => Some(c),
+        });
+        let _ = r;
+        c.filter(within).map(|c| vec![((q - c).norm(), c)]).unwrap_or_default()
+    }
+}
+
+#[test]
+fn shortcuts_agree_with_the_face_by_face_search() {
+    // region walls ask for contacts at every particle and step: outside a
+    // closed block demx clamps the point, inside a cylinder or cone it skips
+    // the face points when a bound puts every face beyond the cutoff. Both
+    // must give what every face tried one by one gives.
+    let mut seed = 0x9e3779b97f4a7c15u64;
+    let mut unit = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let out = reg("region b block -1 2 -0.5 1.5 0 3 side out units box", &[]);
+    let cone = reg("region c cone z 0.5 0.5 0.3 2.0 0 4 units box", &[]);
+    let cyl = reg("region y cylinder z 0.5 0.5 1.5 0 4 units box", &[]);
+    let (mut outside, mut near, mut far) = (0, 0, 0);
+    for _ in 0..20_000 {
+        let q = V3::new(-3.0 + 7.0 * unit(), -3.0 + 6.0 * unit(), -1.0 + 6.0 * unit());
+        let cutoff = 0.05 + 0.6 * unit();
+        // block, side out: the six faces' closest points
+        let (lo, hi) = (V3::new(-1.0, -0.5, 0.0), V3::new(2.0, 1.5, 3.0));
+        if !(0..3).all(|d| q[d] >= lo[d] && q[d] <= hi[d]) {
+            outside += 1;
+            let faces: Vec<V3> = (0..6)
+                .map(|f| {
+                    let (d, at) = (f / 2, if f % 2 == 0 { lo[f / 2] } else { hi[f / 2] });
+                    let mut c = V3::new(q.x.clamp(lo.x, hi.x), q.y.clamp(lo.y, hi.y), q.z.clamp(lo.z, hi.z));
+                    c[d] = at;
+                    c
+                })
+                .collect();
+            let want = by_faces(&out, q, cutoff, &faces, false);
+            let got: Vec<(f64, V3)> = out.surface_contacts(q, cutoff).iter().map(|c| (c.distance, c.point)).collect();
+            assert_eq!(got.len(), want.len(), "block, q {q:?}, cutoff {cutoff}");
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g.0 - w.0).abs() <= 1e-12 && close(g.1, w.1), "block, q {q:?}: {g:?} against {w:?}");
+            }
+        }
+        // cone and cylinder, side in: the contacts must be the same with
+        // the shortcut as with a cutoff so large that it never applies
+        for r in [&cone, &cyl] {
+            if !r.contains(q) {
+                continue;
+            }
+            let all = r.surface_contacts(q, 1e3);
+            let want: Vec<_> = all.iter().filter(|c| c.distance < cutoff).collect();
+            let got = r.surface_contacts(q, cutoff);
+            if want.is_empty() {
+                far += 1;
+            } else {
+                near += 1;
+            }
+            assert_eq!(got.len(), want.len(), "{}, q {q:?}, cutoff {cutoff}", r.id);
+            for (g, w) in got.iter().zip(&want) {
+                assert_eq!(g, *w, "{}, q {q:?}", r.id);
+            }
+        }
+    }
+    assert!(outside > 5_000 && near > 1_000 && far > 1_000, "cases: {outside} outside, {near} near, {far} far");
+}

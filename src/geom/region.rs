@@ -713,9 +713,9 @@ impl Region {
             }
             _ => {
                 if interior {
-                    self.interior_contacts(q, cutoff)
+                    self.interior_contacts(q, cutoff, self.open)
                 } else {
-                    self.exterior_contacts(q, cutoff).into_iter().collect()
+                    self.exterior_contacts(q, cutoff, self.open).into_iter().collect()
                 }
             }
         };
@@ -743,52 +743,49 @@ impl Region {
 
     /// Distance from q (own frame) to the closed surface, ignoring open faces.
     fn surface_distance_local(&self, q: V3) -> f64 {
-        let mut r = self.clone();
-        r.open = [false; 6];
-        r.motion = None;
-        let c = if r.inside(q) { r.interior_contacts(q, f64::INFINITY) } else { r.exterior_contacts(q, f64::INFINITY).into_iter().collect() };
+        // every face closed; q is in the own frame already
+        const CLOSED: [bool; 6] = [false; 6];
+        let c = if self.inside(q) { self.interior_contacts(q, f64::INFINITY, CLOSED) } else { self.exterior_contacts(q, f64::INFINITY, CLOSED).into_iter().collect() };
         if c.is_empty() {
             return 0.0;
         }
         c.iter().map(|c| c.distance).fold(f64::INFINITY, f64::min)
     }
 
-    fn faces(&self) -> Vec<Face> {
+    /// The closed faces of a block or prism (none for other shapes), in
+    /// LAMMPS's face order; an array, not a Vec: region walls ask for them
+    /// for every particle at every step.
+    fn faces(&self, open: [bool; 6]) -> impl Iterator<Item = Face> {
+        let mut f = [None; 6];
         match &self.shape {
             Shape::Block { lo, hi } => {
-                let mut f = Vec::new();
                 for d in 0..3 {
                     for (k, v) in [lo[d], hi[d]].into_iter().enumerate() {
-                        if !self.open[2 * d + k] {
-                            f.push(Face::AxisRect { dim: d, at: v, lo: *lo, hi: *hi });
-                        }
+                        f[2 * d + k] = Some(Face::AxisRect { dim: d, at: v, lo: *lo, hi: *hi });
                     }
                 }
-                f
             }
             Shape::Prism { lo, hi, tilt } => {
                 let [o, a, b, c] = prism_edges(*lo, *hi, *tilt);
                 // face order as LAMMPS prism: xlo xhi ylo yhi zlo zhi
                 let faces = [(o, b, c), (o + a, b, c), (o, a, c), (o + b, a, c), (o, a, b), (o + c, a, b)];
-                faces
-                    .iter()
-                    .enumerate()
-                    .filter(|(i, _)| !self.open[*i])
-                    .map(|(_, (o, e1, e2))| Face::Para { o: *o, e1: *e1, e2: *e2 })
-                    .collect()
+                for (i, (o, e1, e2)) in faces.into_iter().enumerate() {
+                    f[i] = Some(Face::Para { o, e1, e2 });
+                }
             }
-            _ => Vec::new(),
+            _ => {}
         }
+        f.into_iter().zip(open).filter_map(|(f, open)| f.filter(|_| !open))
     }
 
-    fn interior_contacts(&self, q: V3, cutoff: f64) -> Vec<SurfaceContact> {
+    fn interior_contacts(&self, q: V3, cutoff: f64, open: [bool; 6]) -> Vec<SurfaceContact> {
         let mut out = Vec::new();
         match &self.shape {
             Shape::Block { lo, hi } => {
                 if (0..3).any(|d| q[d] <= lo[d] || q[d] >= hi[d]) {
                     return out;
                 }
-                for f in self.faces() {
+                for f in self.faces(open) {
                     let c = f.closest(q);
                     if (q - c).norm() < cutoff {
                         out.extend(contact(q, c));
@@ -800,7 +797,7 @@ impl Region {
                 if (0..3).any(|d| f[d] <= 0.0 || f[d] >= 1.0) {
                     return out;
                 }
-                for face in self.faces() {
+                for face in self.faces(open) {
                     let c = face.plane_projection(q);
                     if (q - c).norm() < cutoff {
                         out.extend(contact(q, c));
@@ -822,13 +819,28 @@ impl Region {
                     out.extend(contact(q, q - normal * d));
                 }
             }
-            Shape::Axisym { .. } => {
+            Shape::Axisym { axis, c1, c2, rlo, rhi, lo, hi, .. } => {
                 if !self.inside(q) {
                     return out;
                 }
+                // far from every face (a lower bound on the distance to the
+                // side: the radial gap times the cosine of the half-angle, with
+                // a margin for rounding): no contact, no face points
+                let (d1, d2) = perp_dims(*axis);
+                let a = q[*axis];
+                let rr = ((q[d1] - c1).powi(2) + (q[d2] - c2).powi(2)).sqrt();
+                let (len, dr) = (hi - lo, rhi - rlo);
+                if len > 0.0 && len < BIG {
+                    let r = rlo + dr * (a - lo) / len;
+                    let side = (r - rr) * len / (len * len + dr * dr).sqrt();
+                    let margin = cutoff * (1.0 + 1e-9) + 1e-12 * (1.0 + q.norm());
+                    if side > margin && a - lo > margin && hi - a > margin {
+                        return out;
+                    }
+                }
                 for (k, c) in self.axisym_face_points(q).into_iter().enumerate() {
                     if let Some(c) = c {
-                        if !self.open[k] && (q - c).norm() < cutoff {
+                        if !open[k] && (q - c).norm() < cutoff {
                             out.extend(contact(q, c));
                         }
                     }
@@ -839,9 +851,18 @@ impl Region {
         out
     }
 
-    fn exterior_contacts(&self, q: V3, cutoff: f64) -> Option<SurfaceContact> {
-        let best = |cands: Vec<V3>| -> Option<SurfaceContact> {
-            let c = cands.into_iter().min_by(|a, b| (q - a).norm().total_cmp(&(q - b).norm()))?;
+    fn exterior_contacts(&self, q: V3, cutoff: f64, open: [bool; 6]) -> Option<SurfaceContact> {
+        // the first closest candidate, compared by squared distance (one
+        // square root for the winner, not two for every comparison)
+        let best = |cands: &mut dyn Iterator<Item = V3>| -> Option<SurfaceContact> {
+            let mut win: Option<(V3, f64)> = None;
+            for c in cands {
+                let d2 = (q - c).norm_squared();
+                if win.map_or(true, |(_, w)| d2 < w) {
+                    win = Some((c, d2));
+                }
+            }
+            let (c, _) = win?;
             if (q - c).norm() < cutoff {
                 contact(q, c)
             } else {
@@ -853,21 +874,25 @@ impl Region {
                 if (0..3).all(|d| q[d] > lo[d] && q[d] < hi[d]) {
                     return None;
                 }
-                best(self.faces().iter().map(|f| f.closest(q)).collect())
+                if !open.iter().any(|o| *o) {
+                    // outside a closed box, the closest surface point is q clamped to it
+                    return best(&mut std::iter::once(V3::new(q.x.clamp(lo.x, hi.x), q.y.clamp(lo.y, hi.y), q.z.clamp(lo.z, hi.z))));
+                }
+                best(&mut self.faces(open).map(|f| f.closest(q)))
             }
             Shape::Prism { lo, hi, tilt } => {
                 let f = prism_frac(*lo, *hi, *tilt, q);
                 if (0..3).all(|d| f[d] > 0.0 && f[d] < 1.0) {
                     return None;
                 }
-                best(self.faces().iter().map(|f| f.closest(q)).collect())
+                best(&mut self.faces(open).map(|f| f.closest(q)))
             }
             Shape::Sphere { center, radius } => {
                 let r = (q - center).norm();
                 if r < *radius || r == 0.0 {
                     return None;
                 }
-                best(vec![center + (q - center) * (radius / r)])
+                best(&mut std::iter::once(center + (q - center) * (radius / r)))
             }
             Shape::Plane { point, normal } => {
                 let d = -(q - point).dot(normal);
@@ -886,7 +911,7 @@ impl Region {
                     return None;
                 }
                 let pts = self.axisym_face_points(q);
-                best(pts.iter().enumerate().filter(|(k, _)| !self.open[*k]).filter_map(|(_, c)| *c).collect())
+                best(&mut pts.iter().enumerate().filter(|(k, _)| !open[*k]).filter_map(|(_, c)| *c))
             }
             Shape::Union(_) | Shape::Intersect(_) => None,
         }
@@ -928,6 +953,7 @@ impl Region {
 }
 
 /// A planar face used for closest-point queries.
+#[derive(Clone, Copy)]
 enum Face {
     /// Face of an axis-aligned box: coordinate `dim` == `at`, others within lo..hi.
     AxisRect { dim: usize, at: f64, lo: V3, hi: V3 },
