@@ -306,6 +306,8 @@ pub fn thermo_keyword(sim: &Sim, k: &str) -> Option<f64> {
             norm(sim.temperature() * 0.5 * sim.temp_dof() * sim.boltz)
         }
         "pe" | "epair" | "emol" | "evdwl" | "ecoul" | "ebond" | "elong" => 0.0,
+        // pe + ke as LAMMPS adds them (pe is 0 for granular pairs), which
+        // also turns ke's -0 into 0
         "etotal" => 0.0 + norm(sim.temperature() * 0.5 * sim.temp_dof() * sim.boltz),
         "press" => {
             let v = d.map_or(0.0, |d| d.volume());
