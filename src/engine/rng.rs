@@ -18,6 +18,31 @@ impl Park {
         let s = seed.rem_euclid(IM);
         Park { seed: if s == 0 { 1 } else { s } }
     }
+    /// LAMMPS `RanPark::reset(ibase, coord)`: a generator seeded from a
+    /// seed and a point, so that an atom's draw does not depend on which
+    /// process owns it (`set type/fraction`). Jenkins' one-at-a-time hash
+    /// over the bytes of the 32-bit seed and the three doubles as they lie in
+    /// memory (little-endian), each byte added as a signed char; the seed is
+    /// the hash's low 27 bits (0 -> 1), then five draws are discarded.
+    pub fn from_point(seed: i32, x: [f64; 3]) -> Park {
+        let mut hash: u32 = 0;
+        let mut mix = |b: u8| {
+            hash = hash.wrapping_add(b as i8 as i32 as u32);
+            hash = hash.wrapping_add(hash << 10);
+            hash ^= hash >> 6;
+        };
+        seed.to_le_bytes().into_iter().for_each(&mut mix);
+        x.iter().flat_map(|c| c.to_le_bytes()).for_each(&mut mix);
+        hash = hash.wrapping_add(hash << 3);
+        hash ^= hash >> 11;
+        hash = hash.wrapping_add(hash << 15);
+        let s = (hash & 0x7ffffff) as i64;
+        let mut p = Park { seed: if s == 0 { 1 } else { s } };
+        for _ in 0..5 {
+            p.uniform();
+        }
+        p
+    }
     /// Uniform in (0, 1).
     pub fn uniform(&mut self) -> f64 {
         let k = self.seed / IQ;

@@ -551,6 +551,34 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     let mut count = 0;
     while a.more() {
         let k = a.word("keyword")?;
+        if k.text == "type/fraction" {
+            // LAMMPS set.cpp TYPE_FRACTION: each selected atom draws from a
+            // generator seeded by the seed and its position, and takes the new
+            // type when the draw is at most the fraction
+            let newtype = a.i64("type")?;
+            let fraction = a.f64("fraction")?;
+            let seed = a.i64("seed")?;
+            let ntypes = s.sim.ntypes as i64;
+            if newtype < 1 || newtype > ntypes {
+                return Err(a.err_prev(format!("set type/fraction: type {newtype} is not between 1 and {ntypes}")));
+            }
+            if !(0.0..=1.0).contains(&fraction) {
+                return Err(a.err_prev(format!("set type/fraction: fraction {fraction} is not between 0 and 1")));
+            }
+            if seed <= 0 || seed > i32::MAX as i64 {
+                return Err(a.err_prev(format!("set type/fraction: seed {seed} must be a positive 32-bit integer")));
+            }
+            let p = &mut s.sim.particles;
+            count = 0;
+            for i in 0..p.len() {
+                if select[i] && crate::engine::rng::Park::from_point(seed as i32, [p.x[i].x, p.x[i].y, p.x[i].z]).uniform() <= fraction {
+                    p.kind[i] = newtype as u32;
+                    count += 1;
+                }
+            }
+            s.sim.log.line(&format!("  {count} settings made for type/fraction"));
+            continue;
+        }
         let v = a.word("value")?;
         let val = parse_f64(v)?;
         let p = &mut s.sim.particles;
