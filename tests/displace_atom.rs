@@ -6,9 +6,9 @@
 //! lets them fall and fly (one through a periodic side), and dumps
 //! `c_d[1..4]` every 1500 steps; demx's dumps must agree atom by atom.
 
+mod common;
+
 use std::collections::BTreeMap;
-use std::path::Path;
-use std::process::Command;
 
 const LAMMPS_DECK: &str = "units si\natom_style sphere\nboundary p p f\nnewton off\ncomm_modify vel yes\n\
 region reg block -0.02 0.02 -0.02 0.02 0 0.04 units box\ncreate_box 2 reg\nneighbor 0.001 bin\n\
@@ -23,40 +23,10 @@ velocity all set 0.3 -0.2 0.0 units box\nfix integr all nve/sphere\n\
 dump t all custom 1500 displace.dump id type x y z ix iy iz c_d[1] c_d[2] c_d[3] c_d[4]\n\
 dump_modify t format line \"%d %d %.17g %.17g %.17g %d %d %d %.17g %.17g %.17g %.17g\" sort id\nrun 3000\n";
 
-/// step -> id -> the row's values after the id.
-fn frames(path: &Path) -> BTreeMap<i64, BTreeMap<i64, Vec<f64>>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut out = BTreeMap::new();
-    let mut lines = text.lines().peekable();
-    let mut step = 0;
-    while let Some(l) = lines.next() {
-        if l.starts_with("ITEM: TIMESTEP") {
-            step = lines.next().unwrap().trim().parse().unwrap();
-        } else if l.starts_with("ITEM: ATOMS") {
-            let rows: &mut BTreeMap<i64, Vec<f64>> = out.entry(step).or_default();
-            while lines.peek().map_or(false, |l| !l.starts_with("ITEM")) {
-                let v: Vec<f64> = lines.next().unwrap().split_whitespace().map(|w| w.parse().unwrap()).collect();
-                rows.insert(v[0] as i64, v[1..].to_vec());
-            }
-        }
-    }
-    out
-}
-
-fn run(dir: &Path, cmd: &mut Command) {
-    let o = cmd.current_dir(dir).output().expect("run the engine");
-    assert!(o.status.success(), "{cmd:?} failed: {}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-}
-
 /// Runs `deck` in the engine and in demx; returns (engine's frames, demx's).
 fn both(engine: &str, deck: &str, dump: &str) -> (BTreeMap<i64, BTreeMap<i64, Vec<f64>>>, BTreeMap<i64, BTreeMap<i64, Vec<f64>>>) {
-    let (theirs, ours) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    for d in [&theirs, &ours] {
-        std::fs::write(d.path().join("in.deck"), deck).unwrap();
-    }
-    run(theirs.path(), Command::new(engine).args(["-in", "in.deck", "-log", "none", "-echo", "none"]));
-    run(ours.path(), Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck", "--log", "none"]));
-    (frames(&theirs.path().join(dump)), frames(&ours.path().join(dump)))
+    let b = common::engine_and_demx(engine, "in.deck", &[("in.deck", deck)]);
+    (common::dump_frames(&b.theirs.path().join(dump)), common::dump_frames(&b.ours.path().join(dump)))
 }
 
 /// Every row of every frame within 1e-12 m of the engine's; returns the

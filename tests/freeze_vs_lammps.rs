@@ -9,8 +9,9 @@
 //! were NaN. Both, printed every 50 steps by `fix print`, must now follow
 //! LAMMPS's.
 
+mod common;
+
 use std::path::Path;
-use std::process::Command;
 
 /// 8 x 8 x 8 spheres of 2 mm diameter, 1.98 mm apart.
 fn data() -> String {
@@ -46,21 +47,11 @@ fn printed(dir: &Path) -> Vec<[f64; 3]> {
         .collect()
 }
 
-fn run(dir: &Path, cmd: &mut Command) {
-    let o = cmd.current_dir(dir).output().expect("run the engine");
-    assert!(o.status.success(), "{cmd:?} failed: {}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-}
-
 #[test]
 fn frozen_layer_forces_and_pressure_follow_lammps() {
-    let (ours, theirs) = (tempfile::tempdir().expect("tempdir"), tempfile::tempdir().expect("tempdir"));
-    for d in [&ours, &theirs] {
-        std::fs::write(d.path().join("data.spheres"), data()).unwrap();
-        std::fs::write(d.path().join("in.deck"), DECK).unwrap();
-    }
-    run(theirs.path(), Command::new("lmp").args(["-in", "in.deck", "-log", "none", "-screen", "none"]));
-    run(ours.path(), Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck"]));
-    let (a, b) = (printed(ours.path()), printed(theirs.path()));
+    let data = data();
+    let both = common::engine_and_demx("lmp", "in.deck", &[("data.spheres", &data), ("in.deck", DECK)]);
+    let (a, b) = (printed(both.ours.path()), printed(both.theirs.path()));
     assert_eq!(a.len(), 7, "rows at steps 0, 50, ..., 300");
     assert_eq!(a.len(), b.len());
     for (r, s) in a.iter().zip(&b) {

@@ -9,33 +9,9 @@
 //! The thermo rows of every run must agree: exactly while nothing touches, to
 //! 1e-5 relative once the grains pile up (rounding grows in a heap).
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
 const EXAMPLES: &str = "/usr/share/lammps/examples/granregion";
-
-/// The thermo rows (words) of each run, from a log's `Step` headers to `Loop time`.
-fn thermo_runs(out: &str) -> Vec<Vec<Vec<String>>> {
-    let mut runs = vec![];
-    let mut cur: Option<Vec<Vec<String>>> = None;
-    for l in out.lines() {
-        if l.trim_start().starts_with("Step ") {
-            cur = Some(vec![]);
-        } else if l.starts_with("Loop time") {
-            runs.extend(cur.take());
-        } else if let Some(rows) = cur.as_mut() {
-            rows.push(l.split_whitespace().map(String::from).collect());
-        }
-    }
-    runs
-}
-
-fn run(dir: &Path, cmd: &mut Command) -> String {
-    let o = cmd.current_dir(dir).output().expect("run the engine");
-    let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-    assert!(o.status.success(), "{cmd:?} failed: {text}");
-    text
-}
 
 /// Runs Debian's deck `name` in lmp and demx, its runs cut to `steps` and
 /// thermo every 500 steps; returns both thermo tables.
@@ -54,13 +30,8 @@ fn both(name: &str, steps: &[i64]) -> (Vec<Vec<Vec<String>>>, Vec<Vec<Vec<String
         })
         .collect();
     assert!(runs.next().is_none(), "{name}: fewer run commands than expected");
-    let (theirs, ours) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    for d in [&theirs, &ours] {
-        std::fs::write(d.path().join(name), &deck).unwrap();
-    }
-    let t = run(theirs.path(), Command::new("lmp").args(["-in", name, "-log", "none", "-echo", "none"]));
-    let o = run(ours.path(), Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", name, "--log", "none"]));
-    (thermo_runs(&t), thermo_runs(&o))
+    let b = common::engine_and_demx("lmp", name, &[(name, &deck)]);
+    (common::thermo_runs(&b.theirs_out), common::thermo_runs(&b.ours_out))
 }
 
 /// Rows equal in step and atoms; the other columns (but cpu, column 1) within

@@ -3,6 +3,8 @@
 //! one-at-a-time hash, `RanPark::reset`), so the types are the same as
 //! lmp's atom by atom, not only in proportion.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
@@ -23,20 +25,10 @@ fn types(dir: &Path) -> BTreeMap<i64, i64> {
     .collect()
 }
 
-fn run(dir: &Path, cmd: &mut Command) {
-    let o = cmd.current_dir(dir).output().expect("run the engine");
-    assert!(o.status.success(), "{cmd:?} failed: {}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-}
-
 #[test]
 fn types_follow_lammps_atom_by_atom() {
-    let (theirs, ours) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    for d in [&theirs, &ours] {
-        std::fs::write(d.path().join("in.deck"), DECK).unwrap();
-    }
-    run(theirs.path(), Command::new("lmp").args(["-in", "in.deck", "-log", "none", "-echo", "none"]));
-    run(ours.path(), Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck", "--log", "none"]));
-    let (want, got) = (types(theirs.path()), types(ours.path()));
+    let b = common::engine_and_demx("lmp", "in.deck", &[("in.deck", DECK)]);
+    let (want, got) = (types(b.theirs.path()), types(b.ours.path()));
     assert_eq!(want.len(), 308, "lmp's fcc lattice");
     let count = |t: i64| want.values().filter(|&&v| v == t).count();
     // both draws took about their fractions: all three types are there

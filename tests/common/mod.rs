@@ -1,0 +1,79 @@
+//! Helpers for the tests that run a real engine (`lmp`, `liggghts`) and demx
+//! on the same deck: each such test file says `mod common;`.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::Command;
+use tempfile::TempDir;
+
+/// Runs `cmd` in `dir`; panics with its output unless it exits 0. Returns
+/// stdout and stderr together.
+pub fn run(dir: &Path, cmd: &mut Command) -> String {
+    let o = cmd.current_dir(dir).output().expect("run the engine");
+    let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "{cmd:?} failed: {text}");
+    text
+}
+
+/// One deck run by an engine and by demx, each in a fresh directory.
+pub struct Both {
+    pub theirs: TempDir,
+    pub ours: TempDir,
+    /// The engine's screen output.
+    pub theirs_out: String,
+    /// demx's screen output.
+    pub ours_out: String,
+}
+
+/// Writes `files` (name, text) into two fresh directories and runs the deck
+/// `deck` (one of them) with `engine -in deck` in the first and `demx run
+/// deck` in the second.
+pub fn engine_and_demx(engine: &str, deck: &str, files: &[(&str, &str)]) -> Both {
+    let (theirs, ours) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    for d in [&theirs, &ours] {
+        for (name, text) in files {
+            std::fs::write(d.path().join(name), text).unwrap();
+        }
+    }
+    let theirs_out = run(theirs.path(), Command::new(engine).args(["-in", deck, "-log", "none", "-echo", "none"]));
+    let ours_out = run(ours.path(), Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", deck, "--log", "none"]));
+    Both { theirs, ours, theirs_out, ours_out }
+}
+
+/// A text dump's frames: step -> atom id -> the row's values after the id.
+pub fn dump_frames(path: &Path) -> BTreeMap<i64, BTreeMap<i64, Vec<f64>>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut out = BTreeMap::new();
+    let mut lines = text.lines().peekable();
+    let mut step = 0;
+    while let Some(l) = lines.next() {
+        if l.starts_with("ITEM: TIMESTEP") {
+            step = lines.next().unwrap().trim().parse().unwrap();
+        } else if l.starts_with("ITEM: ATOMS") {
+            let rows: &mut BTreeMap<i64, Vec<f64>> = out.entry(step).or_default();
+            while lines.peek().map_or(false, |l| !l.starts_with("ITEM")) {
+                let v: Vec<f64> = lines.next().unwrap().split_whitespace().map(|w| w.parse().unwrap()).collect();
+                rows.insert(v[0] as i64, v[1..].to_vec());
+            }
+        }
+    }
+    out
+}
+
+/// The thermo rows (words) of each run in a screen output, from a `Step`
+/// header to `Loop time`.
+pub fn thermo_runs(out: &str) -> Vec<Vec<Vec<String>>> {
+    let mut runs = vec![];
+    let mut cur: Option<Vec<Vec<String>>> = None;
+    for l in out.lines() {
+        if l.trim_start().starts_with("Step ") {
+            cur = Some(vec![]);
+        } else if l.starts_with("Loop time") {
+            runs.extend(cur.take());
+        } else if let Some(rows) = cur.as_mut() {
+            rows.push(l.split_whitespace().map(String::from).collect());
+        }
+    }
+    runs
+}
