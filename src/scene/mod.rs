@@ -110,7 +110,6 @@ const NOOP_COMMANDS: &[&str] = &[
     "package",
     "suffix",
     "balance",
-    "compute_modify",
     "neigh_modify_noop",
     "sort",
     "timer",
@@ -260,19 +259,8 @@ impl Session {
             "run" => self.run_command(cmd, vars),
             "atom_modify" => self.atom_modify(cmd),
             "demx_guard" => self.guard_command(cmd),
+            "compute_modify" => self.compute_modify(cmd),
             n if NOOP_COMMANDS.contains(&n) => {
-                if n == "compute_modify" {
-                    // `compute_modify ID dynamic/dof yes` (`dynamic` before 2019 and in
-                    // LIGGGHTS): the temperature counts atoms at every use
-                    let w = &cmd.words;
-                    if w.get(1).map_or(false, |id| id.text == "thermo_temp" || self.sim.computes.iter().any(|c| c.id == id.text && c.style == "temp")) {
-                        for k in 2..w.len().saturating_sub(1) {
-                            if matches!(w[k].text.as_str(), "dynamic/dof" | "dynamic") {
-                                self.sim.dof_dynamic = matches!(w[k + 1].text.as_str(), "yes" | "on");
-                            }
-                        }
-                    }
-                }
                 if n == "newton" {
                     let a = Args::new(cmd);
                     if let Some(w) = a.peek() {
@@ -294,6 +282,29 @@ impl Session {
                 Err(e)
             }
         }
+    }
+
+    /// `compute_modify ID dynamic/dof yes` (`dynamic` before 2019 and in LIGGGHTS): the
+    /// temperature counts the atoms at every use instead of at the run's setup. Read for
+    /// `thermo_temp` and computes of style temp; demx keeps one flag for all of them. The
+    /// other keywords (`extra/dof`, `dynamic/dof` of other computes) are accepted with a note.
+    fn compute_modify(&mut self, cmd: &Command) -> Result<()> {
+        let w = &cmd.words;
+        let Some(id) = w.get(1) else {
+            return Err(Error::deck(cmd.words[0].span, "compute_modify needs a compute ID and keywords"));
+        };
+        let is_temp = id.text == "thermo_temp" || self.sim.computes.iter().any(|c| c.id == id.text && c.style == "temp");
+        let mut used = false;
+        for k in 2..w.len().saturating_sub(1) {
+            if is_temp && matches!(w[k].text.as_str(), "dynamic/dof" | "dynamic") {
+                self.sim.dof_dynamic = matches!(w[k + 1].text.as_str(), "yes" | "on");
+                used = true;
+            }
+        }
+        if !used {
+            self.notes.push((cmd.span, "compute_modify: accepted; changes nothing in demx".to_string()));
+        }
+        Ok(())
     }
 
     fn fix_command(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
