@@ -173,7 +173,7 @@ impl Default for Sim {
             force_rebuild: true,
             clock: Instant::now(),
             dry: false,
-            boltz: 1.380649e-23,
+            boltz: 1.3806504e-23,
             last_rate: 0.0,
             timing: [0.0; 4],
             pass_secs: 0.0,

@@ -23,9 +23,12 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                 other => return Err(Error::unsupported(u.span, format!("units {other}"))),
             };
             let (boltz, skin) = match s.units {
-                Units::Si => (1.380649e-23, 0.001),
+                // Boltzmann constants of both engines (CODATA 2006; LAMMPS 2022 `update.cpp`,
+                // LIGGGHTS 3.8), not the 2019 SI value: temperatures and `velocity create`
+                // then match theirs to the bit
+                Units::Si => (1.3806504e-23, 0.001),
                 Units::Lj => (1.0, 0.3),
-                Units::Cgs => (1.380649e-16, 0.1),
+                Units::Cgs => (1.3806504e-16, 0.1),
             };
             s.sim.boltz = boltz;
             s.sim.neigh.skin = skin;
