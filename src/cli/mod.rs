@@ -193,6 +193,7 @@ pub fn run_deck(
     session.threads = threads;
     session.max_steps = max_steps;
     session.perturb = deck.perturb;
+    session.dialect_hint = std::fs::read_to_string(&deck.deck).ok().and_then(|t| crate::scene::sniff_dialect(&t));
     if check || quiet {
         session.sim.log.screen = false;
     }

@@ -71,6 +71,10 @@ pub struct Session {
     pub schedule: Vec<RunRecord>,
     /// Whether the dialect was fixed by a command.
     pub dialect_known: bool,
+    /// The dialect the deck's `pair_style` lines tell ([`sniff_dialect`]),
+    /// for commands that differ between the engines and come before any
+    /// command that fixes the dialect (`set diameter`).
+    pub dialect_hint: Option<Dialect>,
     /// Regions deleted (`region ID delete`) since the last run.
     pub deleted_regions: Vec<String>,
     /// `hard_particles yes` (LIGGGHTS: moduli above 1 GPa allowed).
@@ -168,6 +172,7 @@ impl Session {
             notes: vec![],
             schedule: vec![],
             dialect_known: false,
+            dialect_hint: None,
             deleted_regions: vec![],
             hard_particles: false,
             soft_particles: false,
@@ -189,6 +194,16 @@ impl Session {
             self.sim.dialect = d;
             self.sim.thermo.dialect = d;
             self.dialect_known = true;
+        }
+    }
+
+    /// The dialect as far as it is known: fixed by a command, else the
+    /// deck's hint, else LIGGGHTS.
+    pub fn dialect_now(&self) -> Dialect {
+        if self.dialect_known {
+            self.sim.dialect
+        } else {
+            self.dialect_hint.unwrap_or(Dialect::Liggghts)
         }
     }
 
@@ -602,5 +617,28 @@ impl Host for Session {
                 self.sim.log.open(p, append).map_err(|e| Error::io(span, format!("cannot open log file '{p}'"), &e))
             }
         }
+    }
+}
+
+/// The dialect a deck's text tells before it is run, from its `pair_style`
+/// lines as `pair_style` itself decides: `gran` is LIGGGHTS 3.x; `granular`
+/// and `gran/...` are LAMMPS, unless the deck also defines `fix ...
+/// property/global`, which only LIGGGHTS (2.x with the old styles) has.
+pub fn sniff_dialect(text: &str) -> Option<Dialect> {
+    let mut lammps = false;
+    let mut liggghts_fix = false;
+    for line in text.lines() {
+        let mut w = line.split('#').next().unwrap_or("").split_whitespace();
+        match (w.next(), w.next()) {
+            (Some("pair_style"), Some("gran")) => return Some(Dialect::Liggghts),
+            (Some("pair_style"), Some(st)) if st == "granular" || st.starts_with("gran/") => lammps = true,
+            (Some("fix"), Some(_)) => liggghts_fix |= w.nth(1).map_or(false, |st| st == "property/global"),
+            _ => {}
+        }
+    }
+    match (lammps, liggghts_fix) {
+        (true, false) => Some(Dialect::Lammps),
+        (true, true) => Some(Dialect::Liggghts),
+        _ => None,
     }
 }

@@ -584,6 +584,9 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         }
         let v = a.word("value")?;
         let val = parse_f64(v)?;
+        // LAMMPS's `set diameter` keeps the mass ("does not adjust the
+        // particle mass", set command doc); LIGGGHTS's keeps the density
+        let diameter_keeps_mass = s.dialect_now() == crate::engine::sim::Dialect::Lammps;
         let p = &mut s.sim.particles;
         count = 0;
         for i in 0..p.len() {
@@ -592,6 +595,10 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             }
             count += 1;
             match k.text.as_str() {
+                "diameter" if diameter_keeps_mass => {
+                    p.radius[i] = 0.5 * val;
+                    p.density[i] = p.mass[i] / crate::engine::particles::Particles::sphere_mass(p.radius[i], 1.0);
+                }
                 "diameter" => {
                     p.radius[i] = 0.5 * val;
                     p.mass[i] = crate::engine::particles::Particles::sphere_mass(p.radius[i], p.density[i]);
