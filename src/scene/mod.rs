@@ -16,6 +16,7 @@ pub mod insert;
 pub mod mesh;
 pub mod wind;
 pub mod overrides;
+pub mod velocity;
 
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{did_you_mean, Error, Result};

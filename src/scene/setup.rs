@@ -687,26 +687,17 @@ fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args, vars: &Variabl
         }
         "zero" => {
             let k = a.choice("zero what", &["linear", "angular"])?;
-            let p = &mut s.sim.particles;
-            if k.text == "linear" {
-                let (mut m, mut mv) = (0.0, V3::zeros());
-                for i in 0..p.len() {
-                    if p.mask[i] & bit != 0 {
-                        m += p.mass[i];
-                        mv += p.v[i] * p.mass[i];
-                    }
-                }
-                if m > 0.0 {
-                    let vc = mv / m;
-                    for i in 0..p.len() {
-                        if p.mask[i] & bit != 0 {
-                            p.v[i] -= vc;
-                        }
-                    }
-                }
+            if a.more() && a.choice("keyword", &["rigid"])?.text == "rigid" {
+                return Err(Error::unsupported(a.prev().map_or(cmd.span, |w| w.span), "velocity zero ... rigid"));
             }
-            Ok(())
+            let done = if k.text == "linear" {
+                super::velocity::zero_momentum(&mut s.sim, bit)
+            } else {
+                super::velocity::zero_rotation(&mut s.sim, bit)
+            };
+            done.map_err(|e| Error::deck(k.span, e))
         }
+        "create" | "scale" => super::velocity::thermal(s, cmd, style, a, bit),
         _ => Err(Error::unsupported(style.span, format!("velocity {}", style.text))),
     }
 }
