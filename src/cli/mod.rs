@@ -206,8 +206,45 @@ pub fn run_deck(
     if check {
         interp.set_command_limit(2_000_000);
     }
+    if let Some(text) = std::fs::read_to_string(&deck.deck).ok().filter(|t| crate::convert::is_legacy_liggghts(t)) {
+        match legacy_in_memory(&sources, &deck.deck, &text) {
+            Ok(converted) => {
+                session.sim.log.line(&format!(
+                    "note: {}: LIGGGHTS 1.x/2.x syntax; running it as `demx convert --to liggghts` rewrites it \
+                     (error locations refer to that text)",
+                    deck.deck.display()
+                ));
+                session.dialect_hint = crate::scene::sniff_dialect(&converted);
+                interp.preload(&deck.deck, converted);
+            }
+            Err(e) => return (session, sources, Err(e)),
+        }
+    }
     let r = interp.run_file(&deck.deck, &mut session);
     (session, sources, r)
+}
+
+/// A LIGGGHTS 1.x/2.x deck as LIGGGHTS 3.x text, when `demx convert`
+/// rewrites every line exactly (new prime seeds, split fixes and moved
+/// values are exact); the caller notes on the screen and log that the run uses it. With an
+/// approximated or dropped line the run stops at that line (exit 3).
+fn legacy_in_memory(sources: &SourceMap, path: &std::path::Path, text: &str) -> Result<String> {
+    use crate::convert::{convert, Severity, Target};
+    let c = convert(text, Target::Liggghts);
+    if let Some(n) = c.notes.iter().find(|n| n.severity > Severity::Info) {
+        // the span of the line's text, after its indentation
+        let start: usize = text.split_inclusive('\n').take(n.line.saturating_sub(1)).map(str::len).sum();
+        let line = text[start..].lines().next().unwrap_or("");
+        let indent = line.len() - line.trim_start().len();
+        let id = sources.add(path.to_path_buf(), text.to_string());
+        let span = crate::script::Span::new(id, start + indent, start + line.trim_end().len().max(indent + 1));
+        let msg = format!("running this LIGGGHTS 1.x/2.x line (its conversion to 3.x would be approximate: {})", n.message);
+        return Err(Error::unsupported(span, msg).with_hint(format!(
+            "`demx convert {} --to liggghts` writes the 3.x deck with its notes, to edit and run",
+            path.display()
+        )));
+    }
+    Ok(c.text)
 }
 
 fn report(err: &Error, sources: &SourceMap) -> ExitCode {

@@ -405,6 +405,30 @@ enum Item {
     Comment(String, Vec<String>),
 }
 
+/// Whether a deck is written for LIGGGHTS 1.x/2.x: a `pair_style
+/// gran/hooke...` or `gran/hertz/history`, or a `fix wall/gran/STYLE`, whose
+/// words are not LAMMPS's numbers (a word with `$` or `v_` counts as a
+/// number), or a `fix mesh/gran` or `move/mesh/gran`. LIGGGHTS 3.8 rejects
+/// such decks; `demx run` converts them in memory.
+pub fn is_legacy_liggghts(src: &str) -> bool {
+    let numbers = |w: &[String]| w.iter().all(|x| deck::is_number(x) || x == "NULL" || x.contains('$') || x.starts_with("v_"));
+    logical_lines(src).iter().any(|l| {
+        let w = l.words();
+        match w.first().map(String::as_str) {
+            Some("pair_style") if w.len() >= 2 && matches!(w[1].as_str(), "gran/hooke" | "gran/hooke/history" | "gran/hertz/history") => {
+                !(w.len() >= 7 && numbers(&w[2..7]))
+            }
+            Some("fix") if w.len() >= 4 => {
+                let style = w[3].as_str();
+                (style.starts_with("wall/gran/") && style != "wall/gran/region" && !(w.len() >= 9 && numbers(&w[4..9])))
+                    || style == "mesh/gran"
+                    || style == "move/mesh/gran"
+            }
+            _ => false,
+        }
+    })
+}
+
 /// Convert deck text to `to`. Never fails on deck content: what cannot be
 /// converted is commented out and noted.
 pub fn convert(src: &str, to: Target) -> Converted {

@@ -120,6 +120,13 @@ impl Interpreter {
         self.run_id(id, host)
     }
 
+    /// Use `text` as the contents of the file at `path` when it is run, included or
+    /// jumped to (a deck converted in memory).
+    pub fn preload(&mut self, path: &Path, text: String) {
+        let id = self.sources.add(path.to_path_buf(), text);
+        self.files.insert(path.to_path_buf(), id);
+    }
+
     /// Run deck text under a name (the name is what `jump SELF` and error
     /// messages use; `jump NAME` reads the file of that name from disk).
     pub fn run_text(&mut self, name: &str, text: &str, host: &mut dyn Host) -> Result<()> {
