@@ -694,8 +694,9 @@ impl Fix for WallGranRegion {
                 p.f[i] += out.force_i(&c);
                 p.torque[i] += out.torque_i;
             }
+            // free the slots of faces left; a free slot is all zeros already
             for k in 0..REGION_SLOTS {
-                if !used[k] {
+                if !used[k] && data[k * w + 3] != 0.0 {
                     data[k * w..(k + 1) * w].fill(0.0);
                 }
             }
