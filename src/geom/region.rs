@@ -696,10 +696,13 @@ impl Region {
                 for (i, r) in s.iter().enumerate() {
                     let side = if interior { r.interior } else { !r.interior };
                     for c in r.surface_side(q, cutoff, side) {
+                        // a union drops a contact inside another closed member
+                        // (LAMMPS `RegUnion::surface_interior`: match and not
+                        // openflag); the open test first, as the strict inside
+                        // test measures the distance to every face
                         let keep = s.iter().enumerate().filter(|(j, _)| *j != i).all(|(_, o)| {
-                            let m = o.contains_strict(c.point);
                             if is_union {
-                                !m || o.open.iter().any(|f| *f)
+                                o.open.iter().any(|f| *f) || !o.contains_strict(c.point)
                             } else {
                                 o.contains(c.point)
                             }
