@@ -193,7 +193,10 @@ pub fn run_deck(
     session.threads = threads;
     session.max_steps = max_steps;
     session.perturb = deck.perturb;
-    session.dialect_hint = std::fs::read_to_string(&deck.deck).ok().and_then(|t| crate::scene::sniff_dialect(&t));
+    // the deck's text, read once here for what is decided before it runs
+    // (its dialect, whether it is a legacy deck); the run reads it again
+    let text = std::fs::read_to_string(&deck.deck).ok();
+    session.dialect_hint = text.as_deref().and_then(crate::scene::sniff_dialect);
     if check || quiet {
         session.sim.log.screen = false;
     }
@@ -206,7 +209,7 @@ pub fn run_deck(
     if check {
         interp.set_command_limit(2_000_000);
     }
-    if let Some(text) = std::fs::read_to_string(&deck.deck).ok().filter(|t| crate::convert::is_legacy_liggghts(t)) {
+    if let Some(text) = text.filter(|t| crate::convert::is_legacy_liggghts(t)) {
         match legacy_in_memory(&sources, &deck.deck, &text) {
             Ok(converted) => {
                 session.sim.log.line(&format!(
