@@ -115,7 +115,7 @@ pub struct Gravity {
     pub acc: V3,
     /// Magnitude, possibly a variable name.
     pub magnitude: Magnitude,
-    /// Unit direction.
+    /// Direction: unit up to the rounding of the engines' arithmetic.
     pub dir: V3,
 }
 
@@ -514,28 +514,35 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
         "gravity" => {
             let magnitude = Magnitude::parse(a, "magnitude")?;
             let kind = a.choice("gravity style", &["vector", "spherical", "chute"])?;
-            let dir = match kind.text.as_str() {
-                "vector" => V3::new(a.f64("x")?, a.f64("y")?, a.f64("z")?),
-                "chute" => {
-                    let ang = a.f64("angle")?.to_radians();
-                    V3::new(ang.sin(), 0.0, -ang.cos())
-                }
-                _ => {
-                    let phi = a.f64("phi")?.to_radians();
-                    let theta = a.f64("theta")?.to_radians();
-                    if sim.domain.as_ref().map_or(false, |d| d.dimension == 2) {
-                        // LAMMPS FixGravity 2d: x = sin(theta), y = cos(theta)
-                        V3::new(theta.sin(), theta.cos(), 0.0)
-                    } else {
-                        V3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
-                    }
+            let two_d = sim.domain.as_ref().map_or(false, |d| d.dimension == 2);
+            // `FixGravity::set_acceleration` of LAMMPS and LIGGGHTS alike: chute
+            // is spherical with phi = 0 and theta = 180 - angle, so its axis is
+            // -z in 3d and -y in 2d; neither is normalised (sin and cos as
+            // they round); a vector is, over x and y alone in 2d
+            let spherical = |phi: f64, theta: f64| {
+                let (phi, theta) = (phi.to_radians(), theta.to_radians());
+                if two_d {
+                    V3::new(theta.sin(), theta.cos(), 0.0)
+                } else {
+                    V3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
                 }
             };
-            let len = dir.norm();
-            if len == 0.0 {
-                return Err(a.err_prev("fix gravity: direction vector is zero"));
-            }
-            let dir = dir / len;
+            let dir = match kind.text.as_str() {
+                "vector" => {
+                    let (x, y, z) = (a.f64("x")?, a.f64("y")?, a.f64("z")?);
+                    let v = V3::new(x, y, if two_d { 0.0 } else { z });
+                    let len = (v.x * v.x + v.y * v.y + v.z * v.z).sqrt();
+                    if len == 0.0 {
+                        return Err(a.err_prev("fix gravity: direction vector is zero"));
+                    }
+                    V3::new(v.x / len, v.y / len, v.z / len)
+                }
+                "chute" => spherical(0.0, 180.0 - a.f64("angle")?),
+                _ => {
+                    let phi = a.f64("phi")?;
+                    spherical(phi, a.f64("theta")?)
+                }
+            };
             let m = if let Magnitude::Const(m) = magnitude { m } else { 0.0 };
             Box::new(Gravity { id, group, acc: dir * m, magnitude, dir })
         }
