@@ -81,7 +81,7 @@ pub trait ContactKernel: Send + Sync {
     /// sets each particle's force and torque to its pairs' sum (each block
     /// clears its particles' first, while they are in cache) and updates the
     /// pairs' history (`hist`, `live`: the list's own, taken out of it);
-    /// returns the pair virial, the sum of r_ij . F_ij.
+    /// returns the pair virial ([`Virial`]).
     ///
     /// Without `tail`, follow with [`cross_gather`]. With one (only for a
     /// list whose pairs reach forward, [`PairList::forward`]), each block
@@ -99,7 +99,7 @@ pub trait ContactKernel: Send + Sync {
         dt: f64,
         force: Forces<'_>,
         tail: Option<&Tail<'_>>,
-    ) -> f64;
+    ) -> Virial;
     /// One contact with a wall or any other partner given as a `Contact`;
     /// history is zeroed when apart. Returns the laws' output.
     fn contact(&self, c: &Contact, params: &PairParams, hist: &mut [f64]) -> ContactOut;
@@ -392,12 +392,12 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         dt: f64,
         force: Forces<'_>,
         tail: Option<&Tail<'_>>,
-    ) -> f64 {
+    ) -> Virial {
         let m = pairs.len();
         let w = Self::WIDTH;
         let bs = pairs.block_size();
         let n = p.x.len();
-        let defer = force.defer;
+        let (defer, tensor) = (force.defer, force.tensor);
         // one slot per cross pair; each block clears its slots first
         let ncross = pairs.block_cross.last().copied().unwrap_or(0) as usize;
         if defer.len() != ncross {
@@ -427,7 +427,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         // one block: its pairs in increasing index; both shares of a pair
         // inside the block are added at once, the share of a particle of
         // another block is kept for the cross pass
-        let block = |(q, h, d, lv, f, tq): &mut Job<'_>| -> f64 {
+        let block = |(q, h, d, lv, f, tq): &mut Job<'_>| -> Virial {
             let (q, h, d, lv, f, tq) = (*q, &mut **h, &mut **d, &mut **lv, &mut **f, &mut **tq);
             let lo = q * bs;
             let ps = block_start[q] as usize;
@@ -437,7 +437,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             d.fill([V3::zeros(); 2]);
             f.fill(V3::zeros());
             tq.fill(V3::zeros());
-            let mut virial = 0.0;
+            let mut virial = Virial::default();
             for k in ps..block_start[q + 1] as usize {
                 let i = a[k] as usize;
                 let j = b[k] as usize;
@@ -468,7 +468,10 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                 let o = self.apply(&c, pp, hk);
                 let fi = o.force_i(&c);
                 // the lane form of the dot product, as the batched pass
-                virial += Vec3::from(p.x[i] - xj).dot(&Vec3::from(fi));
+                virial.trace += Vec3::from(p.x[i] - xj).dot(&Vec3::from(fi));
+                if tensor {
+                    virial.add_tensor(p.x[i] - xj, fi);
+                }
                 f[i - lo] += fi;
                 tq[i - lo] += o.torque_i;
                 if own_j {
@@ -482,21 +485,21 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
         };
         // read here: the blocks may run on other threads
         let dense_only = DENSE_ONLY.is_on();
-        let batched = |(q, h, d, lv, f, tq): &mut Job<'_>| -> f64 {
+        let batched = |(q, h, d, lv, f, tq): &mut Job<'_>| -> Virial {
             let (q, h, d, lv, f, tq) = (*q, &mut **h, &mut **d, &mut **lv, &mut **f, &mut **tq);
             let (ps, pe) = (block_start[q] as usize, block_start[q + 1] as usize);
             d.fill([V3::zeros(); 2]);
             f.fill(V3::zeros());
             tq.fill(V3::zeros());
             let xs = &xslot[block_cross[q] as usize..];
-            let blk = Block { p, a, b, image, images, xs, table, dt, lo: q * bs, ps, pe, dense: dense_only };
+            let blk = Block { p, a, b, image, images, xs, table, dt, lo: q * bs, ps, pe, dense: dense_only, tensor };
             // the batches index without bounds checks what this bounds
             assert!(blk.bounded(f, tq, h, lv, w), "pair list not built for these particles");
             self.block_batched(&blk, h, d, lv, f, tq)
         };
         let lanes = Self::BATCHED && !self.scalar_only();
         let pass = |job: &mut Job<'_>| if lanes { batched(job) } else { block(job) };
-        let virials: Vec<f64> = match tail {
+        let virials: Vec<Virial> = match tail {
             Some(tail) => {
                 fused_blocks(pairs, jobs, &pass, &|s: usize, f: &mut [V3], tq: &mut [V3]| {
                     // SAFETY: the slots block `s` reads were written by
@@ -511,7 +514,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
             None if nblocks > 1 => jobs.par_iter_mut().map(pass).collect(),
             None => jobs.iter_mut().map(pass).collect(),
         };
-        virials.iter().sum()
+        virials.iter().fold(Virial::default(), Virial::plus)
     }
 }
 
@@ -550,15 +553,15 @@ impl<T> Shared<T> {
 fn fused_blocks<'a>(
     pairs: &PairList,
     jobs: Vec<Job<'a>>,
-    pass: &(dyn Fn(&mut Job<'a>) -> f64 + Sync),
+    pass: &(dyn Fn(&mut Job<'a>) -> Virial + Sync),
     finish: &Tail<'_>,
-) -> Vec<f64> {
-    use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
+) -> Vec<Virial> {
+    use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
     use std::sync::{Mutex, PoisonError};
     let nb = jobs.len();
     let count: Vec<AtomicU32> = pairs.block_deps.iter().map(|&c| AtomicU32::new(c)).collect();
     assert_eq!(count.len(), nb, "block dependencies not indexed for this list");
-    let virial: Vec<AtomicU64> = (0..nb).map(|_| AtomicU64::new(0)).collect();
+    let virial: Vec<Mutex<Virial>> = (0..nb).map(|_| Mutex::new(Virial::default())).collect();
     let jobs: Vec<Mutex<Option<Job<'a>>>> = jobs.into_iter().map(|j| Mutex::new(Some(j))).collect();
     let next = AtomicUsize::new(0);
     // tests take the passes last block first: any order is valid
@@ -594,7 +597,7 @@ fn fused_blocks<'a>(
         }
         let q = if reversed { nb - 1 - q } else { q };
         let Some(mut job) = take(q) else { unreachable!("block {q} passed twice") };
-        virial[q].store(pass(&mut job).to_bits(), Ordering::Relaxed);
+        *virial[q].lock().unwrap_or_else(PoisonError::into_inner) = pass(&mut job);
         *jobs[q].lock().unwrap_or_else(PoisonError::into_inner) = Some(job);
         let touched = &pairs.block_touch[pairs.block_touch_start[q] as usize..pairs.block_touch_start[q + 1] as usize];
         for s in std::iter::once(q).chain(touched.iter().map(|&s| s as usize)) {
@@ -612,7 +615,7 @@ fn fused_blocks<'a>(
     } else {
         work();
     }
-    virial.iter().map(|v| f64::from_bits(v.load(Ordering::Relaxed))).collect()
+    virial.into_iter().map(|v| v.into_inner().unwrap_or_else(PoisonError::into_inner)).collect()
 }
 
 /// One block claimed and not yet done (see `fused_blocks`): counted in
@@ -822,6 +825,8 @@ struct Block<'a> {
     pe: usize,
     /// Run it in batches of consecutive pairs however few touch (tests).
     dense: bool,
+    /// Sum the virial tensor ([`Forces::tensor`]).
+    tensor: bool,
 }
 
 impl Block<'_> {
@@ -888,7 +893,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// ([`Self::block_dense`]). Either clears the history of the pairs that
     /// came apart as it finds them.
     #[inline(always)]
-    fn block_batched(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
+    fn block_batched(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> Virial {
         // most pairs touched at the last pass (a bed at rest): batches of
         // consecutive pairs, without a walk that sorts them out first
         let live = lv.iter().map(|&l| (l & 1) as usize).sum::<usize>();
@@ -905,14 +910,14 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// test, on lanes, and adds the forces of those alone, in pair order:
     /// the same contributions in the same order as [`Self::block_walk`].
     #[inline(never)]
-    fn block_dense(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
+    fn block_dense(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> Virial {
         let w = Self::WIDTH;
         // a dense batch's pairs are consecutive: no queue, and their cross
         // slots are counted by the batch
         let none = [0usize; LANES];
         let mut slot = 0;
         let mut lanes = BatchLanes::new();
-        let mut virial = 0.0;
+        let mut virial = Virial::default();
         let n = k.pe - k.ps;
         let mut q0 = 0;
         while q0 < n {
@@ -930,7 +935,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
     /// A block's pairs walked one by one: those apart are sorted out, the
     /// touching ones queued and run in batches.
     #[inline(never)]
-    fn block_walk(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> f64 {
+    fn block_walk(&self, k: &Block<'_>, h: &mut [f64], d: &mut [[V3; 2]], lv: &mut [u8], f: &mut [V3], tq: &mut [V3]) -> Virial {
         let p = k.p;
         let w = Self::WIDTH;
         let mut queue = [0usize; LANES];
@@ -943,7 +948,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // the batches' lanes, cleared once per block: each batch writes
         // every lane it reads
         let mut lanes = BatchLanes::new();
-        let mut virial = 0.0;
+        let mut virial = Virial::default();
         // non-contact cohesion reaches beyond touching, by the pair's
         // `extra_range` (as in the per-contact pass)
         let one_type = k.table.ntypes == 1;
@@ -1009,7 +1014,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         lv: &mut [u8],
         f: &mut [V3],
         tq: &mut [V3],
-        virial: &mut f64,
+        virial: &mut Virial,
     ) {
         let p = k.p;
         let w = Self::WIDTH;
@@ -1116,6 +1121,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // lane read at a varying index pins the whole struct there: each
         // batch copied both)
         let (overlap, ti, tj) = (c.delta, o.torque_i, o.torque_j);
+        // the lanes whose forces are added, for the tensor
+        let mut kept = 0u32;
         for l in 0..count.min(LANES) {
             if DENSE && touch >> l & 1 == 0 {
                 continue;
@@ -1138,7 +1145,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 unsafe { *at_mut(h, q * w + m) = v.0[l] };
             }
             let fl = fi.lane(l);
-            *virial += vir.0[l];
+            virial.trace += vir.0[l];
+            kept |= 1 << l;
             unsafe {
                 *at_mut(f, i - k.lo) += fl;
                 *at_mut(tq, i - k.lo) += ti.lane(l);
@@ -1155,6 +1163,16 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         }
         if DENSE {
             *slot += (cross & ((1u32 << last) << 1).wrapping_sub(1)).count_ones() as usize;
+        }
+        // once per batch, only on the steps that ask: the lanes whose
+        // forces were added, in the same order
+        if k.tensor {
+            let r = s.xi - s.xj;
+            while kept != 0 {
+                let l = kept.trailing_zeros() as usize;
+                virial.add_tensor(r.lane(l), fi.lane(l));
+                kept &= kept - 1;
+            }
         }
     }
 }
@@ -1196,6 +1214,46 @@ pub struct Forces<'a> {
     /// Per cross pair (a range per block, by `b` within it; see `PairList::xslot`): force on `a` and torque on `b`,
     /// zero when the pair is apart.
     pub defer: &'a mut Vec<[V3; 2]>,
+    /// Whether to sum the virial tensor too ([`Virial::tensor`]): only on
+    /// the steps whose output reads it, so the others do not pay for it.
+    pub tensor: bool,
+}
+
+/// The pair virial of a force pass, summed pair by pair in the pass's fixed
+/// order (blocks, then each block's pairs): the trace, sum r_ij . F_ij, on
+/// every pass (it gives `press`), and the tensor, sum r_ij (x) F_ij, where
+/// [`Forces::tensor`] asked for it (zeros otherwise). r_ij = x_i - x_j (at
+/// the pair's image) and F_ij is the force on i; the components are in
+/// LAMMPS's order xx, yy, zz, xy, xz, yz, with xy = sum r_x F_y, as
+/// `Pair::virial_fdotr_compute` sums x_i f_i over owned and ghost atoms.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Virial {
+    /// sum r_ij . F_ij.
+    pub trace: f64,
+    /// sum r_ij (x) F_ij: xx, yy, zz, xy, xz, yz.
+    pub tensor: [f64; 6],
+}
+
+impl Virial {
+    /// One pair's r_ij (x) F_ij added to the tensor.
+    #[inline(always)]
+    fn add_tensor(&mut self, r: V3, f: V3) {
+        let t = &mut self.tensor;
+        t[0] += r.x * f.x;
+        t[1] += r.y * f.y;
+        t[2] += r.z * f.z;
+        t[3] += r.x * f.y;
+        t[4] += r.x * f.z;
+        t[5] += r.y * f.z;
+    }
+    /// `self` then `o`, component by component.
+    fn plus(mut self, o: &Virial) -> Virial {
+        self.trace += o.trace;
+        for (a, b) in self.tensor.iter_mut().zip(&o.tensor) {
+            *a += b;
+        }
+        self
+    }
 }
 
 /// The cross pass: every particle adds the shares of its cross-block pairs
@@ -1284,7 +1342,7 @@ mod tests {
             d.1[b * bs..b * bs + tb.len()].copy_from_slice(tb);
             d.2[b] += 1;
         };
-        let w = laws.force_pass(&PassState::of(p), pl, &mut hist, &mut live, table, 1e-3, Forces { f, torque: t, defer }, fused.then_some(&tail as &Tail<'_>));
+        let w = laws.force_pass(&PassState::of(p), pl, &mut hist, &mut live, table, 1e-3, Forces { f, torque: t, defer, tensor: false }, fused.then_some(&tail as &Tail<'_>)).trace;
         pl.put_history(hist, live);
         if fused {
             let (df, dt, calls) = done.into_inner().unwrap();
@@ -1337,7 +1395,7 @@ mod tests {
                 let (mut f, mut t, mut defer) = (vec![V3::zeros(); p.len()], vec![V3::zeros(); p.len()], vec![]);
                 let tail = |b: usize, _: &mut [V3], _: &mut [V3]| assert_ne!(b, 3, "block 3 fails");
                 std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    let force = Forces { f: &mut f, torque: &mut t, defer: &mut defer };
+                    let force = Forces { f: &mut f, torque: &mut t, defer: &mut defer, tensor: false };
                     laws.force_pass(&PassState::of(&p), &pl, &mut hist, &mut live, &table, 1e-3, force, Some(&tail as &Tail<'_>))
                 }))
                 .is_err()

@@ -190,8 +190,38 @@ fn header_name(k: &str) -> String {
         "spcpu" => "S/CPU".into(),
         "cpuremain" => "CPULeft".into(),
         "density" => "Density".into(),
+        "pxx" => "Pxx".into(),
+        "pyy" => "Pyy".into(),
+        "pzz" => "Pzz".into(),
+        "pxy" => "Pxy".into(),
+        "pxz" => "Pxz".into(),
+        "pyz" => "Pyz".into(),
         other => other.to_string(),
     }
+}
+
+/// The thermo keywords of the pressure tensor, in LAMMPS's order of its
+/// components.
+pub const TENSOR_KEYWORDS: [&str; 6] = ["pxx", "pyy", "pzz", "pxy", "pxz", "pyz"];
+
+/// Component `k` (xx, yy, zz, xy, xz, yz) of the pressure tensor, as
+/// LAMMPS's `compute pressure` (thermo_press, with thermo_temp's kinetic
+/// tensor) gives it in `compute_vector`: (sum m v_a v_b + W_ab) / V, with W
+/// the pair virial tensor of the last force pass; in 2d V is the area and the
+/// components with z are 0. `None` when the last force pass did not sum the
+/// tensor ([`Sim::virial_tensor`]).
+fn pressure_component(sim: &Sim, k: usize) -> Option<f64> {
+    let w = sim.virial_tensor()?;
+    let Some(d) = sim.domain.as_ref() else { return Some(0.0) };
+    let v = d.volume();
+    if v == 0.0 || (d.dimension == 2 && k != 0 && k != 1 && k != 3) {
+        return Some(0.0);
+    }
+    // thermo_temp's vector: the kinetic tensor, summed atom by atom
+    let (a, b) = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)][k];
+    let p = &sim.particles;
+    let ke: f64 = (0..p.len()).map(|i| p.mass[i] * p.v[i][a] * p.v[i][b]).sum();
+    Some((ke + w[k]) / v)
 }
 
 fn is_int_keyword(k: &str) -> bool {
@@ -199,6 +229,12 @@ fn is_int_keyword(k: &str) -> bool {
 }
 
 impl Thermo {
+    /// Whether a column is a component of the pressure tensor, which the
+    /// force passes of the steps that print it sum ([`Sim::virial_tensor`]).
+    pub fn reads_tensor(&self) -> bool {
+        self.keywords.iter().any(|k| TENSOR_KEYWORDS.contains(&k.as_str()))
+    }
+
     /// The header line.
     pub fn header(&self, _sim: &Sim) -> String {
         let mut s = String::new();
@@ -271,6 +307,12 @@ pub fn thermo_value(sim: &Sim, vars: &Variables, k: &str) -> Result<f64> {
     if let Some(rest) = k.strip_prefix("v_") {
         return vars.eval_equal(rest, sim).map_err(err);
     }
+    if TENSOR_KEYWORDS.contains(&k) && sim.virial_tensor().is_none() {
+        return Err(Error::runtime(format!(
+            "thermo keyword {k}: the pressure tensor was not summed at step {} (demx sums it where thermo prints it, and at every step where a variable reads it)",
+            sim.step
+        )));
+    }
     thermo_keyword(sim, k).ok_or_else(|| Error::runtime(format!("unknown thermo keyword {k}")))
 }
 
@@ -318,6 +360,7 @@ pub fn thermo_keyword(sim: &Sim, k: &str) -> Option<f64> {
                 (sim.temp_dof().max(0.0) * sim.boltz * sim.temperature() + sim.virial()) / (dim * v)
             }
         }
+        "pxx" | "pyy" | "pzz" | "pxy" | "pxz" | "pyz" => pressure_component(sim, TENSOR_KEYWORDS.iter().position(|t| *t == k)?)?,
         "vol" => d.map_or(0.0, |d| d.volume()),
         "lx" => d.map_or(0.0, |d| d.len(0)),
         "ly" => d.map_or(0.0, |d| d.len(1)),

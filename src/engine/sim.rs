@@ -3,7 +3,7 @@
 use super::compute::Compute;
 use super::domain::Domain;
 use super::fix::{Chunk, Fix, Hole, Hook, Local, Stage};
-use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable, PassState, Shared};
+use super::kernel::{cross_gather, cross_gather_chunk, ContactKernel, Forces, ParamTable, PassState, Shared, Virial};
 use super::neighbor::{Due, NeighSettings, PairList, Travel};
 use super::output::{Dump, Logger, Thermo};
 use super::particles::Particles;
@@ -79,8 +79,14 @@ pub struct Sim {
     pub pairs: PairList,
     /// Deferred shares of cross-block pairs (scratch of the force pass).
     pub pair_defer: Vec<[V3; 2]>,
-    /// Pair virial sum r_ij . F_ij of the last force evaluation.
-    pub pair_virial: f64,
+    /// Pair virial of the last force evaluation: the trace always, the
+    /// tensor where that pass summed it ([`Sim::tensor_at`]).
+    pub pair_virial: Virial,
+    /// The step whose force pass summed the virial tensor last.
+    pub tensor_at: Option<i64>,
+    /// Sum the virial tensor on every step, not only where thermo prints
+    /// it: a variable reads a tensor keyword (set at each run's start).
+    pub tensor_every_step: bool,
     /// The contact model (None: no pair interactions).
     pub model: Option<PairModel>,
     /// Fixes in definition order.
@@ -154,7 +160,9 @@ impl Default for Sim {
             neigh: NeighSettings::default(),
             pairs: PairList::default(),
             pair_defer: vec![],
-            pair_virial: 0.0,
+            pair_virial: Virial::default(),
+            tensor_at: None,
+            tensor_every_step: false,
             model: None,
             fixes: vec![],
             computes: vec![],
@@ -309,7 +317,8 @@ impl Sim {
     /// The force pass of [`Sim::pair_forces_dt`] without its cross pass,
     /// which the step's fused tail runs (`one_step`).
     fn pair_pass(&mut self, dt: f64) {
-        self.pair_virial = 0.0;
+        self.pair_virial = Virial::default();
+        let tensor = self.tensor_due();
         let p = &mut self.particles;
         let Some(m) = &self.model else {
             p.f.fill(V3::zeros());
@@ -319,8 +328,9 @@ impl Sim {
         // the force pass clears the forces block by block
         let (mut f, mut torque) = (std::mem::take(&mut p.f), std::mem::take(&mut p.torque));
         let (mut hist, mut live) = self.pairs.take_history();
-        let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer };
+        let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer, tensor };
         self.pair_virial = m.kernel.force_pass(&PassState::of(&self.particles), &self.pairs, &mut hist, &mut live, &m.table, dt, force, None);
+        self.tensor_at = if tensor { Some(self.step) } else { None };
         self.pairs.put_history(hist, live);
         let p = &mut self.particles;
         (p.f, p.torque) = (f, torque);
@@ -356,6 +366,7 @@ impl Sim {
         use std::sync::{Mutex, PoisonError};
         let start = Instant::now();
         let (measure, lim) = self.measuring(measure);
+        let tensor = self.tensor_due();
         let (mut hist, mut live) = self.pairs.take_history();
         let Some(m) = &self.model else { unreachable!("fused pass without a pair model") };
         let Particles { x, radius, mass, kind, mask, v, omega, f, torque, extra, frozen, .. } = &mut self.particles;
@@ -404,9 +415,10 @@ impl Sim {
             *moved[s].lock().unwrap_or_else(PoisonError::into_inner) = travel;
             tail_ns.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         };
-        let force = Forces { f: &mut fv, torque: &mut tv, defer: &mut self.pair_defer };
+        let force = Forces { f: &mut fv, torque: &mut tv, defer: &mut self.pair_defer, tensor };
         let virial = m.kernel.force_pass(&state, pairs, &mut hist, &mut live, &m.table, self.dt, force, Some(&tail));
         self.pair_virial = virial;
+        self.tensor_at = if tensor { Some(self.step) } else { None };
         self.pairs.put_history(hist, live);
         (self.particles.f, self.particles.torque) = (fv, tv);
         stages.clear();
@@ -443,6 +455,7 @@ impl Sim {
     pub fn run(&mut self, n: i64, vars: &Variables, pre: bool, post: bool) -> Result<()> {
         self.run_start = self.step;
         self.run_end = self.step + n;
+        self.tensor_every_step = vars.reads_thermo(&super::output::TENSOR_KEYWORDS);
         self.clock = Instant::now();
         self.timing = [0.0; 4];
         self.walked = 0;
@@ -764,7 +777,31 @@ impl Sim {
 
     /// Pair virial trace sum r_ij . F_ij of the last force evaluation.
     pub fn virial(&self) -> f64 {
-        self.pair_virial
+        self.pair_virial.trace
+    }
+
+    /// The pair virial tensor sum r_ij (x) F_ij of the last force
+    /// evaluation (xx, yy, zz, xy, xz, yz), if that pass summed it.
+    pub fn virial_tensor(&self) -> Option<[f64; 6]> {
+        (self.tensor_at == Some(self.step)).then_some(self.pair_virial.tensor)
+    }
+
+    /// Whether this step's force pass sums the virial tensor: on every
+    /// step while a variable may read a tensor keyword
+    /// ([`Sim::tensor_every_step`]); else, while thermo reads one, on the
+    /// steps it prints (the run's first and last steps and every N, as
+    /// [`Sim::output`]) and those where a fix writes at the end of the step
+    /// (a restart file keeps the tensor for the resumed run's first line).
+    /// Other steps do not pay for it.
+    fn tensor_due(&self) -> bool {
+        if self.tensor_every_step {
+            return true;
+        }
+        if !self.thermo.reads_tensor() {
+            return false;
+        }
+        let (step, every) = (self.step, self.thermo.every);
+        step == self.run_start || step == self.run_end || (every > 0 && step % every == 0) || self.fixes.iter().any(|f| f.end_of_step_due(step))
     }
 }
 

@@ -137,10 +137,10 @@ fn check_thermo_keyword(s: &Session, w: &crate::script::Word) -> Result<()> {
     if k.starts_with("c_") || k.starts_with("f_") || k.starts_with("v_") {
         return Ok(());
     }
-    if crate::engine::output::thermo_keyword(&s.sim, k).is_some() {
+    if crate::engine::output::thermo_keyword(&s.sim, k).is_some() || crate::engine::output::TENSOR_KEYWORDS.contains(&k) {
         return Ok(());
     }
-    const OTHER: &[&str] = &["enthalpy", "ecouple", "econserve", "xy", "xz", "yz", "pxx", "pyy", "pzz", "pxy", "pxz", "pyz", "fmax", "fnorm", "part", "timeremain", "tpcpu", "lat", "bonds", "angles", "dihedrals", "impropers", "cella", "cellb", "cellc", "cellalpha", "cellbeta", "cellgamma", "evdwl", "ecoul", "epair", "ebond", "eangle", "edihed", "eimp", "emol", "elong", "etail", "xlat", "ylat", "zlat", "nbuild", "ndanger"];
+    const OTHER: &[&str] = &["enthalpy", "ecouple", "econserve", "xy", "xz", "yz", "fmax", "fnorm", "part", "timeremain", "tpcpu", "lat", "bonds", "angles", "dihedrals", "impropers", "cella", "cellb", "cellc", "cellalpha", "cellbeta", "cellgamma", "evdwl", "ecoul", "epair", "ebond", "eangle", "edihed", "eimp", "emol", "elong", "etail", "xlat", "ylat", "zlat", "nbuild", "ndanger"];
     if OTHER.contains(&k) {
         return Err(Error::unsupported(w.span, format!("thermo keyword {k}")));
     }

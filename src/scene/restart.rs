@@ -76,6 +76,13 @@ pub struct RestartState {
     x_built: Vec<[f64; 3]>,
     last_build: i64,
     builds: u64,
+    /// The pair virial of the last force pass (its trace; its tensor where
+    /// that pass summed it), which the resumed run's first thermo line
+    /// prints, as the saved forces stand for that pass.
+    #[serde(default)]
+    virial: f64,
+    #[serde(default)]
+    virial_tensor: Option<[f64; 6]>,
     /// Commands (as text) that defined units, materials and the contact model.
     pub replay: Vec<String>,
 }
@@ -133,6 +140,8 @@ impl RestartState {
             x_built: pairs.x_built.iter().map(v3).collect(),
             last_build: pairs.last_build,
             builds: pairs.builds,
+            virial: sim.pair_virial.trace,
+            virial_tensor: sim.virial_tensor(),
             replay,
         })
     }
@@ -253,6 +262,8 @@ impl RestartState {
         };
         sim.pairs.set_shifts(&self.pair_shift.iter().map(a3).collect::<Vec<_>>());
         sim.pairs.index(n);
+        sim.pair_virial = crate::engine::kernel::Virial { trace: self.virial, tensor: self.virial_tensor.unwrap_or_default() };
+        sim.tensor_at = self.virial_tensor.map(|_| self.step);
         // continue exactly: the next run reuses the saved list and forces
         sim.force_rebuild = false;
         sim.resume = true;

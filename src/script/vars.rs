@@ -180,6 +180,21 @@ impl Variables {
         v
     }
 
+    /// Whether some formula variable reads one of the thermo keywords
+    /// `names` (as a bare word of its formula).
+    pub fn reads_thermo(&self, names: &[&str]) -> bool {
+        fn reads(e: &Expr, names: &[&str]) -> bool {
+            match e {
+                Expr::Thermo(k) => names.contains(&k.as_str()),
+                Expr::Neg(a) | Expr::Not(a) => reads(a, names),
+                Expr::Bin(_, a, b) => reads(a, names) || reads(b, names),
+                Expr::Func(_, args) => args.iter().any(|a| reads(a, names)),
+                _ => false,
+            }
+        }
+        self.vars.values().any(|v| matches!(&v.data, Data::Formula { expr, .. } if reads(expr, names)))
+    }
+
     /// `" (did you mean 'x'?)"`-style hint text for an unknown name, if any.
     pub fn suggest(&self, name: &str) -> Option<String> {
         did_you_mean(name, self.vars.keys().map(|s| s.as_str())).map(|s| format!("did you mean '{s}'?"))
@@ -587,7 +602,7 @@ impl Variables {
                 }
                 Val::V(ctx.atom_vector(kw)?)
             }
-            Expr::Thermo(kw) => Val::S(ctx.thermo(kw).ok_or_else(|| format!("unknown keyword '{kw}' in variable formula"))?),
+            Expr::Thermo(kw) => Val::S(ctx.thermo(kw).ok_or_else(|| format!("unknown keyword '{kw}' in variable formula (or a value the last step did not compute)"))?),
         })
     }
 
