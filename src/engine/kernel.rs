@@ -470,7 +470,7 @@ impl<N: NormalLaw + Send, T: TangentialLaw + Send, C: CohesionLaw + Send, R: Rol
                 // the lane form of the dot product, as the batched pass
                 virial.trace += Vec3::from(p.x[i] - xj).dot(&Vec3::from(fi));
                 if tensor {
-                    virial.add_tensor(p.x[i] - xj, fi);
+                    add_tensor(&mut virial.tensor, p.x[i] - xj, fi);
                 }
                 f[i - lo] += fi;
                 tq[i - lo] += o.torque_i;
@@ -917,7 +917,9 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         let none = [0usize; LANES];
         let mut slot = 0;
         let mut lanes = BatchLanes::new();
-        let mut virial = Virial::default();
+        // the trace a plain local, as the hot loop adds to it; the tensor
+        // apart, which only the out-of-line `batch_tensor` touches
+        let (mut trace, mut tensor) = (0.0, [0.0; 6]);
         let n = k.pe - k.ps;
         let mut q0 = 0;
         while q0 < n {
@@ -926,10 +928,10 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 prefetch_ahead::<true>(k, h, q0 + l, w);
             }
             let dense = Dense { first: k.ps + q0, slot: &mut slot };
-            self.run_batch::<true>(k, &mut lanes, &none, &none, dense, count, h, d, lv, f, tq, &mut virial);
+            self.run_batch::<true>(k, &mut lanes, &none, &none, dense, count, h, d, lv, f, tq, &mut trace, &mut tensor);
             q0 += count;
         }
-        virial
+        Virial { trace, tensor }
     }
 
     /// A block's pairs walked one by one: those apart are sorted out, the
@@ -948,7 +950,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // the batches' lanes, cleared once per block: each batch writes
         // every lane it reads
         let mut lanes = BatchLanes::new();
-        let mut virial = Virial::default();
+        let (mut trace, mut tensor) = (0.0, [0.0; 6]);
         // non-contact cohesion reaches beyond touching, by the pair's
         // `extra_range` (as in the per-contact pass)
         let one_type = k.table.ntypes == 1;
@@ -982,19 +984,20 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             // SAFETY: q < pe - ps, the block's pairs ([`Block::bounded`])
             unsafe { came_apart(h, lv, q, w, apart) };
             if queued == LANES {
-                self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, LANES, h, d, lv, f, tq, &mut virial);
+                self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, LANES, h, d, lv, f, tq, &mut trace, &mut tensor);
                 queued = 0;
             }
         }
         if queued > 0 {
-            self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, queued, h, d, lv, f, tq, &mut virial);
+            self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, queued, h, d, lv, f, tq, &mut trace, &mut tensor);
         }
-        virial
+        Virial { trace, tensor }
     }
 
     /// Gather `count` queued pairs into lanes (the rest repeat the last one
     /// and are dropped), run the laws, write history back and add forces in
-    /// queue order, and the lanes' virial to `virial`, in queue order.
+    /// queue order, and the lanes' virial to `trace` (and, where the block
+    /// asks, [`Block::tensor`], to `tensor`), in queue order.
     /// `DENSE`: the pairs, the `count` from `dense.first`, were not sorted
     /// out by the walk; the batch sets their live flags, keeps the touching
     /// lanes alone, and counts their cross slots on from `dense.slot`
@@ -1014,7 +1017,8 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         lv: &mut [u8],
         f: &mut [V3],
         tq: &mut [V3],
-        virial: &mut Virial,
+        trace: &mut f64,
+        tensor: &mut [f64; 6],
     ) {
         let p = k.p;
         let w = Self::WIDTH;
@@ -1121,8 +1125,6 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // lane read at a varying index pins the whole struct there: each
         // batch copied both)
         let (overlap, ti, tj) = (c.delta, o.torque_i, o.torque_j);
-        // the lanes whose forces are added, for the tensor
-        let mut kept = 0u32;
         for l in 0..count.min(LANES) {
             if DENSE && touch >> l & 1 == 0 {
                 continue;
@@ -1145,8 +1147,7 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
                 unsafe { *at_mut(h, q * w + m) = v.0[l] };
             }
             let fl = fi.lane(l);
-            virial.trace += vir.0[l];
-            kept |= 1 << l;
+            *trace += vir.0[l];
             unsafe {
                 *at_mut(f, i - k.lo) += fl;
                 *at_mut(tq, i - k.lo) += ti.lane(l);
@@ -1164,16 +1165,27 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         if DENSE {
             *slot += (cross & ((1u32 << last) << 1).wrapping_sub(1)).count_ones() as usize;
         }
-        // once per batch, only on the steps that ask: the lanes whose
-        // forces were added, in the same order
+        // only on the steps that ask, out of line: on the others the loop
+        // above is all there is (a mask of kept lanes built in it cost bed
+        // (a) ~7% of its pair time)
         if k.tensor {
-            let r = s.xi - s.xj;
-            while kept != 0 {
-                let l = kept.trailing_zeros() as usize;
-                virial.add_tensor(r.lane(l), fi.lane(l));
-                kept &= kept - 1;
-            }
+            let extra: [f64; LANES] = std::array::from_fn(|l| if C::NONCONTACT { coeffs.p[l].extra_range } else { 0.0 });
+            batch_tensor(tensor, &(s.xi - s.xj), &fi, &overlap, &extra, if DENSE { touch } else { u32::MAX }, count.min(LANES));
         }
+    }
+}
+
+/// A batch's share of the virial tensor: the lanes below `count` whose forces
+/// the batch added (those in `touch` whose overlap is beyond `-extra`, as the
+/// batch decides), in lane order.
+#[cold]
+#[inline(never)]
+fn batch_tensor(tensor: &mut [f64; 6], r: &Vec3<F8>, f: &Vec3<F8>, overlap: &F8, extra: &[f64; LANES], touch: u32, count: usize) {
+    for l in 0..count {
+        if touch >> l & 1 == 0 || overlap.0[l] <= -extra[l] {
+            continue;
+        }
+        add_tensor(tensor, r.lane(l), f.lane(l));
     }
 }
 
@@ -1234,18 +1246,18 @@ pub struct Virial {
     pub tensor: [f64; 6],
 }
 
+/// One pair's r_ij (x) F_ij added to the tensor `t` ([`Virial::tensor`]).
+#[inline(always)]
+fn add_tensor(t: &mut [f64; 6], r: V3, f: V3) {
+    t[0] += r.x * f.x;
+    t[1] += r.y * f.y;
+    t[2] += r.z * f.z;
+    t[3] += r.x * f.y;
+    t[4] += r.x * f.z;
+    t[5] += r.y * f.z;
+}
+
 impl Virial {
-    /// One pair's r_ij (x) F_ij added to the tensor.
-    #[inline(always)]
-    fn add_tensor(&mut self, r: V3, f: V3) {
-        let t = &mut self.tensor;
-        t[0] += r.x * f.x;
-        t[1] += r.y * f.y;
-        t[2] += r.z * f.z;
-        t[3] += r.x * f.y;
-        t[4] += r.x * f.z;
-        t[5] += r.y * f.z;
-    }
     /// `self` then `o`, component by component.
     fn plus(mut self, o: &Virial) -> Virial {
         self.trace += o.trace;
