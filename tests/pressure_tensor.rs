@@ -127,3 +127,24 @@ thermo_style custom step press pxx pxy\nthermo_modify format float %.15g\nthermo
     assert_eq!(resumed, wrote, "the resumed run's first line against the last line of the run that wrote the restart");
     assert!(resumed[1] > 10.0, "the pair virial is in the pressure: {resumed:?}");
 }
+
+/// Without a pair style the tensor is the kinetic one alone: two atoms of
+/// mass m in a periodic box of volume V, with velocities (1, 2, 3) and
+/// (-1, 0.5, 0), give pxx = m (1 + 1) / V, pxy = m (2 - 0.5) / V, and so on
+/// (LAMMPS's compute pressure with thermo_temp's kinetic tensor).
+#[test]
+fn kinetic_tensor_without_pairs() {
+    let dir = tempfile::tempdir().unwrap();
+    let deck = "units lj\natom_style sphere\nboundary p p p\nregion box block 0 2 0 3 0 4\ncreate_box 1 box\n\
+create_atoms 1 single 0.5 0.5 0.5\ncreate_atoms 1 single 1.5 1.5 1.5\nset atom 1 mass 2.0\nset atom 2 mass 2.0\n\
+velocity all set 1 2 3\nset atom 2 vx -1 vy 0.5 vz 0\n\
+thermo_style custom step pxx pyy pzz pxy pxz pyz\nthermo_modify format float %.15g\nrun 0\n";
+    std::fs::write(dir.path().join("in.gas"), deck).unwrap();
+    let out = common::run(dir.path(), std::process::Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.gas", "--log", "none"]));
+    let r = &rows(&out)[0][0];
+    let (m, v) = (2.0, 24.0);
+    let want = [m * (1.0 + 1.0) / v, m * (4.0 + 0.25) / v, m * 9.0 / v, m * (2.0 - 0.5) / v, m * 3.0 / v, m * 6.0 / v];
+    for k in 0..6 {
+        assert!((r[k + 1] - want[k]).abs() <= 1e-15, "component {k}: {} against {}: {out}", r[k + 1], want[k]);
+    }
+}

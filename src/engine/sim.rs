@@ -319,6 +319,8 @@ impl Sim {
     fn pair_pass(&mut self, dt: f64) {
         self.pair_virial = Virial::default();
         let tensor = self.tensor_due();
+        // a pass without pairs sums a tensor of zeros
+        self.tensor_at = tensor.then_some(self.step);
         let p = &mut self.particles;
         let Some(m) = &self.model else {
             p.f.fill(V3::zeros());
@@ -330,7 +332,6 @@ impl Sim {
         let (mut hist, mut live) = self.pairs.take_history();
         let force = Forces { f: &mut f, torque: &mut torque, defer: &mut self.pair_defer, tensor };
         self.pair_virial = m.kernel.force_pass(&PassState::of(&self.particles), &self.pairs, &mut hist, &mut live, &m.table, dt, force, None);
-        self.tensor_at = if tensor { Some(self.step) } else { None };
         self.pairs.put_history(hist, live);
         let p = &mut self.particles;
         (p.f, p.torque) = (f, torque);
