@@ -1431,7 +1431,7 @@ mod tests {
         assert!(pe > ps, "block 1 has pairs");
         let (f, h, lv) = (vec![V3::zeros(); 64], vec![0.0; (pe - ps) * w], vec![0u8; pe - ps]);
         let bounded = |state: &PassState<'_>, b: &[u32], image: &[u8], f: &[V3], h: &[f64]| {
-            let k = Block { p: state, a: &pl.a, b, image, images: &pl.images, xs: &[], table: &table, dt: 1e-3, lo: 64, ps, pe, dense: false };
+            let k = Block { p: state, a: &pl.a, b, image, images: &pl.images, xs: &[], table: &table, dt: 1e-3, lo: 64, ps, pe, dense: false, tensor: false };
             k.bounded(f, f, h, &lv, w)
         };
         let whole = PassState::of(&p);
