@@ -105,3 +105,33 @@ fn bad_velocity_commands_are_deck_errors() {
     let err = check_error(&format!("{LJ}group one id 7\ndelete_atoms group one compress no\nvelocity all create 1.0 87287\n{DUMP}"));
     assert!(err.contains(&format!("in.deck:{}:", line + 2)) && err.contains("consecutive") && err.contains("loop geom"), "{err}");
 }
+
+/// `velocity ... set` with numbers and no `units`: LAMMPS scales them by the
+/// lattice spacings (units lattice), LIGGGHTS 3.8 does not (its velocity.cpp
+/// defaults to box). A lattice of spacing 1 mm in SI, set to 0.01 m/s in x:
+/// each engine's kinetic energy, and demx's on each dialect, must agree.
+#[test]
+fn velocity_set_units_default_follows_each_engine() {
+    let liggghts = "units si\natom_style granular\natom_modify map array\nboundary p p p\nnewton off\n\
+communicate single vel yes\nregion box block 0 0.006 0 0.006 0 0.006 units box\ncreate_box 1 box\nlattice sc 0.001\n\
+create_atoms 1 box\nset group all diameter 0.00105 density 2500\nvelocity all set 0.01 0 0\n\
+fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\nfix 1 all nve/sphere\ntimestep 1e-7\n\
+thermo_style custom step ke\nthermo_modify format float %.15g\nrun 0\n";
+    let lammps = "units si\natom_style sphere\nboundary p p p\ncomm_modify vel yes\nlattice sc 0.001\n\
+region box block 0 6 0 6 0 6\ncreate_box 1 box\ncreate_atoms 1 box\nset group all diameter 0.00105 density 2500\n\
+velocity all set 0.01 0 0\npair_style gran/hertz/history 1e6 NULL 0 NULL 0.5 0\npair_coeff * *\n\
+thermo_style custom step ke\nthermo_modify format float %.15g\nrun 0\n";
+    // 216 grains of 1.05 mm and 2500 kg/m^3 at 0.01 m/s, or at 1e-5 m/s
+    let m = 2500.0 * std::f64::consts::PI / 6.0 * 0.00105f64.powi(3);
+    for (engine, deck, v) in [("liggghts", liggghts, 0.01), ("lmp", lammps, 0.01 * 0.001)] {
+        let b = common::engine_and_demx(engine, "in.deck", &[("in.deck", deck)]);
+        let ke = |out: &str| -> f64 { common::thermo_runs(out)[0][0][1].parse().unwrap() };
+        let (theirs, ours) = (ke(&b.theirs_out), ke(&b.ours_out));
+        let want = 0.5 * 216.0 * m * v * v;
+        assert!((theirs - want).abs() <= 1e-9 * want, "{engine}'s ke {theirs} against {want}: the deck is not the scene meant");
+        assert!((ours - theirs).abs() <= 1e-12 * theirs, "{engine} deck: demx's ke {ours} against {theirs}");
+    }
+}

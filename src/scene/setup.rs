@@ -3,6 +3,7 @@
 
 use super::args::{bad_keyword, parse_f64, Args};
 use super::{Session, Units};
+use crate::engine::sim::Dialect;
 use crate::engine::domain::{Domain, Side};
 use crate::engine::particles::NewParticle;
 use crate::error::{Error, Result};
@@ -586,7 +587,7 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         let val = parse_f64(v)?;
         // LAMMPS's `set diameter` keeps the mass ("does not adjust the
         // particle mass", set command doc); LIGGGHTS's keeps the density
-        let diameter_keeps_mass = s.dialect_now() == crate::engine::sim::Dialect::Lammps;
+        let diameter_keeps_mass = s.dialect_now() == Dialect::Lammps;
         let p = &mut s.sim.particles;
         count = 0;
         for i in 0..p.len() {
@@ -645,14 +646,16 @@ fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args, vars: &Variabl
                 comps.push((super::fixes::component(a, what)?, span));
             }
             let mut sum = false;
-            let mut scale = lattice_spacing(s);
+            // LAMMPS scales numbers by the lattice spacings unless `units
+            // box`; LIGGGHTS 3.8's velocity command defaults to box
+            // (`scale_flag = 0` in its velocity.cpp)
+            let liggghts = if s.dialect_known { s.sim.dialect == Dialect::Liggghts } else { s.dialect_hint == Some(Dialect::Liggghts) };
+            let mut scale = if liggghts { V3::new(1.0, 1.0, 1.0) } else { lattice_spacing(s) };
             while a.more() {
                 let k = a.choice("keyword", &["units", "sum", "dist", "mom", "rot", "loop", "temp", "bias", "rigid"])?;
                 match k.text.as_str() {
                     "units" => {
-                        if a.choice("units", &["box", "lattice"])?.text == "box" {
-                            scale = V3::new(1.0, 1.0, 1.0);
-                        }
+                        scale = if a.choice("units", &["box", "lattice"])?.text == "box" { V3::new(1.0, 1.0, 1.0) } else { lattice_spacing(s) };
                     }
                     "sum" => sum = a.yes_no("sum")?,
                     _ => {
