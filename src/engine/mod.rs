@@ -13,6 +13,7 @@ pub mod rng;
 pub mod insert;
 pub mod mesh_surface;
 pub mod wind;
+pub mod heat;
 pub mod guard;
 pub mod awake;
 pub mod hugepages;

@@ -844,8 +844,29 @@ impl EvalContext for Sim {
         if prefix == 'c' {
             let c = self.computes.iter().find(|c| c.id == id).ok_or_else(|| format!("compute {id} does not exist"))?;
             c.peratom(self, col)
+        } else if prefix == 'f' && self.particles.extra_index(id).is_some() {
+            let (e, k) = self.extra_column(id, col)?;
+            let e = &self.particles.extra[e];
+            Ok((0..self.particles.len()).map(|i| e.data[i * e.width + k]).collect())
         } else {
             Err(format!("per-atom fix values f_{id} are not available"))
+        }
+    }
+}
+
+impl Sim {
+    /// The extra per-atom column `name` and which of its values `f_name`
+    /// (`col` None) or `f_name[col]` reads: as LIGGGHTS's dump custom, a
+    /// one-value property as `f_name` or `f_name[0]`, a vector's values
+    /// as `[1]`...`[width]`.
+    pub fn extra_column(&self, name: &str, col: Option<usize>) -> std::result::Result<(usize, usize), String> {
+        let e = self.particles.extra_index(name).ok_or_else(|| format!("no per-atom property {name}"))?;
+        let width = self.particles.extra[e].width;
+        match (width, col) {
+            (1, None | Some(0)) => Ok((e, 0)),
+            (1, Some(c)) => Err(format!("f_{name} has one value per atom: f_{name}[{c}] does not exist (use f_{name}[0])")),
+            (w, Some(c)) if (1..=w).contains(&c) => Ok((e, c - 1)),
+            (w, _) => Err(format!("f_{name} has {w} values per atom: use f_{name}[1]..f_{name}[{w}]")),
         }
     }
 }

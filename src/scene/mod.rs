@@ -15,6 +15,7 @@ pub mod restart;
 pub mod insert;
 pub mod mesh;
 pub mod wind;
+pub mod heat;
 pub mod overrides;
 pub mod velocity;
 

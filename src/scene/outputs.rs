@@ -454,14 +454,21 @@ impl DumpText {
     }
 }
 
+/// `ID[k]` as (ID, Some(k)), `ID` as (ID, None).
+fn split_index(rest: &str) -> (&str, Option<usize>) {
+    match rest.find('[') {
+        Some(b) => (&rest[..b], rest[b + 1..].trim_end_matches(']').parse().ok()),
+        None => (rest, None),
+    }
+}
+
 fn column_values(sim: &Sim, c: &str) -> Result<Vec<f64>> {
     use crate::script::EvalContext;
-    if let Some(rest) = c.strip_prefix("c_") {
-        let (id, col) = match rest.find('[') {
-            Some(b) => (&rest[..b], rest[b + 1..].trim_end_matches(']').parse().ok()),
-            None => (rest, None),
-        };
-        return sim.peratom('c', id, col).map_err(|e| Error::runtime(format!("dump column {c}: {e}")));
+    for (prefix, kind) in [("c_", 'c'), ("f_", 'f')] {
+        if let Some(rest) = c.strip_prefix(prefix) {
+            let (id, col) = split_index(rest);
+            return sim.peratom(kind, id, col).map_err(|e| Error::runtime(format!("dump column {c}: {e}")));
+        }
     }
     sim.atom_vector(c).map_err(|e| Error::runtime(format!("dump column {c}: {e}")))
 }
@@ -514,7 +521,17 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
                 if !known {
                     return Err(Error::deck(w.span, format!("dump custom: unknown column '{t}'")));
                 }
-                if t.starts_with("f_") || t.starts_with("v_") {
+                if t.starts_with("f_") {
+                    // per-atom properties demx keeps by name (fix
+                    // property/atom, heat/gran's Temp...); other fixes'
+                    // per-atom values are not available yet
+                    let (fid, col) = split_index(&t[2..]);
+                    if s.sim.particles.extra_index(fid).is_none() {
+                        return Err(Error::unsupported(w.span, format!("dump custom column {t}")));
+                    }
+                    s.sim.extra_column(fid, col).map_err(|e| Error::deck(w.span, format!("dump custom: {e}")))?;
+                }
+                if t.starts_with("v_") {
                     return Err(Error::unsupported(w.span, format!("dump custom column {t}")));
                 }
                 if let Some(rest) = t.strip_prefix("c_") {

@@ -555,6 +555,29 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     let mut count = 0;
     while a.more() {
         let k = a.word("keyword")?;
+        if k.text == "property/atom" || k.text == "property/peratom" {
+            // LIGGGHTS: the named per-atom property of a fix property/atom
+            // (or of a fix that keeps one, as heat/gran's Temp), one value
+            // per column
+            let name = a.word("property name")?;
+            let Some(e) = s.sim.particles.extra_index(&name.text) else {
+                return Err(Error::deck(name.span, format!("set {}: no per-atom property '{}'", k.text, name.text))
+                    .with_hint("a fix property/atom (or fix heat/gran for Temp and heatSource) defines it before the set"));
+            };
+            let width = s.sim.particles.extra[e].width;
+            let mut vals = Vec::with_capacity(width);
+            for _ in 0..width {
+                vals.push(a.f64("value")?);
+            }
+            let data = &mut s.sim.particles.extra[e].data;
+            count = 0;
+            for (i, _) in select.iter().enumerate().filter(|(_, &on)| on) {
+                data[i * width..(i + 1) * width].copy_from_slice(&vals);
+                count += 1;
+            }
+            s.sim.log.line(&format!("  {count} settings made for {}", k.text));
+            continue;
+        }
         if k.text == "type/fraction" {
             // LAMMPS set.cpp TYPE_FRACTION: each selected atom draws from a
             // generator seeded by the seed and its position, and takes the new
@@ -801,7 +824,7 @@ fn overlap_victims(p: &crate::engine::particles::Particles, cut: f64, g1: u32, g
 /// run yet: they get exit 3 naming them, unknown words a did-you-mean error.
 const ENGINE_FIX_STYLES: &[&str] = &[
     "mesh/surface/stress", "mesh/surface/stress/servo", "couple/cfd", "couple/cfd/force", "couple/cfd/force/implicit",
-    "heat/gran", "heat/gran/conduction", "multisphere", "particletemplate/multisphere", "particletemplate/superquadric",
+    "multisphere", "particletemplate/multisphere", "particletemplate/superquadric",
     "massflow/mesh", "ave/euler", "property/atom/tracer", "property/atom/tracer/stream", "wall/region/sph", "insert/pack/dense",
     "nve/sphere/omp", "ave/chunk", "ave/atom", "ave/histo", "ave/correlate", "deform", "rigid", "rigid/small", "spring", "langevin",
     "nvt", "npt", "nph", "wall/reflect", "wall/region", "store/state", "heat/flow", "temp/rescale", "dt/reset", "adapt",
@@ -817,6 +840,7 @@ const DEMX_FIX_STYLES: &[&str] = &[
     "wall/gran", "wall/gran/region", "mesh/surface", "mesh/surface/planar", "move/mesh", "insert/pack", "insert/stream",
     "insert/rate/region", "particletemplate/sphere", "particledistribution/discrete", "pour", "aeolian/wind", "nve/sphere",
     "nve", "gravity", "freeze", "addforce", "setforce", "viscous", "print", "ave/time", "property/global", "property/atom",
+    "heat/gran", "heat/gran/conduction",
 ];
 
 /// Fixes that need geometry, insertion or wind machinery; everything else
@@ -826,6 +850,7 @@ pub fn extended_fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style:
         "wall/gran" if !a.rest().iter().any(|w| w.text == "mesh") => super::walls::wall_gran(s, cmd, id, group, style, a),
         "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" => super::mesh::fix(s, cmd, id, group, style, a, vars),
         "aeolian/wind" => super::wind::fix(s, cmd, id, group, style, a, vars),
+        "heat/gran" | "heat/gran/conduction" => super::heat::fix(s, cmd, id, group, style, a),
         t if ENGINE_FIX_STYLES.contains(&t) || DEMX_FIX_STYLES.contains(&t) || t.starts_with("insert/") || t.starts_with("particle") || t == "adapt" => {
             super::insert::fix(s, cmd, id, group, style, a, vars)
         }
