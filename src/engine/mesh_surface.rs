@@ -66,6 +66,25 @@ pub struct SurfaceMesh {
     /// Counts the changes of the triangles ([`SurfaceMesh::bake`]): a cache
     /// of triangles near particles holds for one epoch.
     pub epoch: u64,
+    /// What the grains push the mesh with (`fix mesh/surface/stress`).
+    pub stress: Option<StressSum>,
+}
+
+/// The force and torque that the grains of a group put on a mesh, summed
+/// by its walls' contacts (LIGGGHTS `fix mesh/surface/stress`: each contact
+/// adds the opposite of its force on the grain, and that force's moment
+/// about the reference point, taken at the contact point).
+#[derive(Clone, Debug, Default)]
+pub struct StressSum {
+    /// Group bit of the grains that count.
+    pub group: u32,
+    /// Reference point of the torque, at the mesh's reference position (it
+    /// moves with the mesh).
+    pub p_ref: V3,
+    /// Force on the mesh.
+    pub force: V3,
+    /// Torque on the mesh about the reference point.
+    pub torque: V3,
 }
 
 fn bits(v: V3) -> [u64; 3] {
@@ -222,7 +241,7 @@ impl SurfaceMesh {
             }).sum::<f64>() / n as f64
         };
         let bins = TriangleBins::new(&mesh, cell);
-        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None, moving: false, epoch: 0 }
+        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None, moving: false, epoch: 0, stress: None }
     }
 
     /// Whether all triangles lie in one plane within the curvature

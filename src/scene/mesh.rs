@@ -15,7 +15,7 @@ use super::Session;
 use crate::engine::fix::{Fix, Hook, Local};
 use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::integrate::CHUNK;
-use crate::engine::mesh_surface::{resolve_among, resolve_particle, MeshHit, SharedMesh, Slots, SurfaceMesh, DEFAULT_CURVATURE_COS, MESH_SLOTS};
+use crate::engine::mesh_surface::{resolve_among, resolve_particle, MeshHit, SharedMesh, Slots, StressSum, SurfaceMesh, DEFAULT_CURVATURE_COS, MESH_SLOTS};
 use crate::engine::output::Dump;
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
@@ -30,7 +30,7 @@ use std::sync::{Arc, RwLock};
 pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
     let _ = vars;
     match style.text.as_str() {
-        "mesh/surface" | "mesh/surface/planar" => mesh_surface(s, cmd, id, style, a),
+        "mesh/surface" | "mesh/surface/planar" | "mesh/surface/stress" => mesh_surface(s, cmd, id, group, style, a),
         "wall/gran" => wall_gran_mesh(s, cmd, id, group, a),
         "move/mesh" => move_mesh(s, cmd, id, a),
         "wall/gran/region" => wall_gran_region(s, cmd, id, group, a),
@@ -44,7 +44,7 @@ fn lock_err() -> Error {
 
 // ---------------------------------------------------------------- registry
 
-/// The fix holding a mesh (`fix mesh/surface`).
+/// The fix holding a mesh (`fix mesh/surface`, `mesh/surface/stress`).
 pub struct MeshSurfaceFix {
     id: String,
     style: String,
@@ -53,8 +53,40 @@ pub struct MeshSurfaceFix {
     summary: String,
 }
 
+impl MeshSurfaceFix {
+    fn stressed(&self) -> bool {
+        self.mesh.read().is_ok_and(|m| m.stress.is_some())
+    }
+}
+
 impl Fix for MeshSurfaceFix {
-    crate::no_step_hooks!();
+    /// mesh/surface/stress clears its sums at the head of each step (the
+    /// engine's pre_force; not at a run's setup, so a run's first line
+    /// adds the setup's contacts to the last step's sums, as the engine's).
+    fn local(&mut self, hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
+        Ok(if hook == Hook::InitialIntegrate && self.stressed() { Local::Whole } else { Local::Nothing })
+    }
+    fn initial_integrate(&mut self, _sim: &mut Sim) {
+        if let Ok(mut m) = self.mesh.write() {
+            if let Some(st) = m.stress.as_mut() {
+                (st.force, st.torque) = (V3::zeros(), V3::zeros());
+            }
+        }
+    }
+    /// `f_ID[1..9]` of mesh/surface/stress: the force on the mesh, its
+    /// torque about the reference point, and that point (where the mesh
+    /// has carried it).
+    fn vector(&self, sim: &Sim, i: usize) -> Option<f64> {
+        let m = self.mesh.read().ok()?;
+        let st = m.stress.as_ref()?;
+        let v = match i {
+            1..=3 => st.force,
+            4..=6 => st.torque,
+            7..=9 => m.to_world(st.p_ref, sim.time),
+            _ => return None,
+        };
+        Some(v[(i - 1) % 3])
+    }
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
     }
@@ -94,7 +126,7 @@ fn need_mesh(s: &Session, w: &Word) -> Result<SharedMesh> {
 
 // ---------------------------------------------------------- mesh/surface
 
-fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, style: &Word, a: &mut Args) -> Result<()> {
+fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args) -> Result<()> {
     s.need_box(cmd)?;
     s.set_dialect(Dialect::Liggghts);
     let mut file: Option<&Word> = None;
@@ -105,6 +137,9 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, style: &Word, a: &mut 
     let mut tolerant = false;
     let mut surface_vel = None;
     let mut transforms = Vec::new();
+    // mesh/surface/stress sums the grains' push unless `stress off`
+    let mut stress = style.text == "mesh/surface/stress";
+    let mut p_ref = V3::zeros();
     let words = a.rest();
     let mut i = 0;
     let num = |i: usize, what: &str| -> Result<f64> {
@@ -168,7 +203,32 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, style: &Word, a: &mut 
             }
             "temperature" | "mass_temperature" => {
                 num(i + 1, &k.text)?;
-                s.notes.push((k.span, format!("fix {}: `{}` accepted; demx has no heat transfer", style.text, k.text)));
+                s.notes.push((k.span, format!("fix {}: `{}` accepted; demx conducts no heat between walls and grains", style.text, k.text)));
+                i += 2;
+            }
+            "stress" | "reference_point" | "wear" if style.text != "mesh/surface/stress" => {
+                return Err(Error::deck(k.span, format!("fix {}: `{}` belongs to fix mesh/surface/stress", style.text, k.text)));
+            }
+            "stress" => {
+                let w = word(i + 1, "on or off")?;
+                stress = match w.text.as_str() {
+                    "on" => true,
+                    "off" => false,
+                    _ => return Err(args::bad_keyword(w, "stress", &["on", "off"])),
+                };
+                i += 2;
+            }
+            "reference_point" => {
+                p_ref = V3::new(num(i + 1, "x")?, num(i + 2, "y")?, num(i + 3, "z")?);
+                i += 4;
+            }
+            "wear" => {
+                let w = word(i + 1, "finnie or off")?;
+                match w.text.as_str() {
+                    "off" => {}
+                    "finnie" => return Err(Error::unsupported(w.span, "fix mesh/surface/stress wear finnie")),
+                    _ => return Err(args::bad_keyword(w, "wear", &["finnie", "off"])),
+                }
                 i += 2;
             }
             "surface_vel" => {
@@ -196,7 +256,7 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, style: &Word, a: &mut 
                 return Err(args::bad_keyword(
                     k,
                     &format!("fix {} keyword", style.text),
-                    &["file", "type", "scale", "move", "rotate", "curvature", "heal", "verbose", "precision", "surface_vel", "temperature"],
+                    &["file", "type", "scale", "move", "rotate", "curvature", "heal", "verbose", "precision", "surface_vel", "temperature", "stress", "reference_point", "wear"],
                 ))
             }
         }
@@ -246,6 +306,11 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, style: &Word, a: &mut 
     }
     let mut mesh = SurfaceMesh::new(id, wall_type, kept, curvature_cos, precision);
     mesh.surface_vel = surface_vel;
+    if style.text == "mesh/surface/stress" {
+        // `stress off`: no grain counts, the sums stay zero (the engine's
+        // f_ID then reads zeros too)
+        mesh.stress = Some(StressSum { group: if stress { group } else { 0 }, p_ref, ..Default::default() });
+    }
     if style.text == "mesh/surface/planar" && !mesh.is_planar() {
         return Err(Error::deck(file.span, format!("fix mesh/surface/planar: mesh '{}' is not planar", file.text)));
     }
@@ -401,8 +466,8 @@ impl Fix for WallGranMesh {
         let (group, width, kernel, table) = (self.group, self.width, &*self.kernel, &self.table);
         for wm in &mut self.meshes {
             let col = sim.particles.add_extra(&wm.hist_name, vec![0.0; len]);
-            let mesh = wm.mesh.read().map_err(|_| lock_err())?;
-            let mesh = &*mesh;
+            let guard = wm.mesh.read().map_err(|_| lock_err())?;
+            let mesh = &*guard;
             let bounded = steady && mesh.motion.is_none();
             let crate::engine::particles::Particles { x, v, omega, f, torque, radius, mass, kind, mask, extra, .. } = &mut sim.particles;
             let (x, v, omega, radius, mass, kind, mask) = (&*x, &*v, &*omega, &*radius, &*mass, &*kind, &*mask);
@@ -444,7 +509,13 @@ impl Fix for WallGranMesh {
                 wm.near_at = Some((builds, mesh.epoch, n));
             }
             let (near, start) = (&wm.near[..], &wm.start[..]);
-            let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Result<()> {
+            // mesh/surface/stress: the grains of its group push the mesh
+            // back; its reference point where the mesh is now
+            let stress = mesh.stress.as_ref().map(|st| (st.group, mesh.to_world(st.p_ref, time)));
+            // each chunk's push on the mesh, summed in chunk order below:
+            // the same bits on any thread count
+            let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Result<(V3, V3)> {
+                let (mut push, mut moment) = (V3::zeros(), V3::zeros());
                 for q in 0..fc.len() {
                     let i = c * CHUNK + q;
                     if mask[i] & group == 0 {
@@ -454,6 +525,7 @@ impl Fix for WallGranMesh {
                     let pref = mesh.to_reference(xi, time);
                     let pp = table.get(kind[i], mesh.wall_type);
                     let (mut fs, mut ts) = (V3::zeros(), V3::zeros());
+                    let pushes = stress.filter(|&(g, _)| mask[i] & g != 0).map(|(_, at)| at);
                     let slots = Slots { data: &mut hc[q * len..(q + 1) * len], width };
                     let apply = |hit: &MeshHit, hist: &mut [f64]| {
                         let nrm = mesh.dir_to_world(hit.normal, time);
@@ -462,8 +534,14 @@ impl Fix for WallGranMesh {
                         let vr = vi - vwall;
                         let c = Contact::with_wall(nrm, ri - hit.delta, hit.delta, ri, ri, mi, vr, wi, dt);
                         let out = kernel.contact(&c, pp, hist);
-                        fs += out.force_i(&c);
+                        let fi = out.force_i(&c);
+                        fs += fi;
                         ts += out.torque_i;
+                        if let Some(at) = pushes {
+                            // the contact point is the triangle's point nearest the centre
+                            push -= fi;
+                            moment += (point - at).cross(&-fi);
+                        }
                     };
                     if bounded {
                         let cands = near[start[i] as usize..start[i + 1] as usize].iter().map(|&t| t as usize);
@@ -474,15 +552,25 @@ impl Fix for WallGranMesh {
                     fc[q] += fs;
                     tc[q] += ts;
                 }
-                Ok(())
+                Ok((push, moment))
             };
             let data = &mut extra[col].data[..n * len];
-            let done: Vec<Result<()>> = if n >= 2 * CHUNK {
+            let done: Vec<Result<(V3, V3)>> = if n >= 2 * CHUNK {
                 f.par_chunks_mut(CHUNK).zip(torque.par_chunks_mut(CHUNK)).zip(data.par_chunks_mut(CHUNK * len)).enumerate().map(body).collect()
             } else {
                 f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * len)).enumerate().map(body).collect()
             };
-            done.into_iter().collect::<Result<Vec<()>>>()?;
+            let parts = done.into_iter().collect::<Result<Vec<(V3, V3)>>>()?;
+            if stress.is_some() {
+                drop(guard);
+                let mut m = wm.mesh.write().map_err(|_| lock_err())?;
+                if let Some(st) = m.stress.as_mut() {
+                    for (push, moment) in parts {
+                        st.force += push;
+                        st.torque += moment;
+                    }
+                }
+            }
         }
         Ok(())
     }

@@ -823,7 +823,7 @@ fn overlap_victims(p: &crate::engine::particles::Particles, cut: f64, g1: u32, g
 /// Fix styles of LIGGGHTS 3.8 and LAMMPS that demx knows by name but does not
 /// run yet: they get exit 3 naming them, unknown words a did-you-mean error.
 const ENGINE_FIX_STYLES: &[&str] = &[
-    "mesh/surface/stress", "mesh/surface/stress/servo", "couple/cfd", "couple/cfd/force", "couple/cfd/force/implicit",
+    "mesh/surface/stress/servo", "couple/cfd", "couple/cfd/force", "couple/cfd/force/implicit",
     "multisphere", "particletemplate/multisphere", "particletemplate/superquadric",
     "massflow/mesh", "ave/euler", "property/atom/tracer", "property/atom/tracer/stream", "wall/region/sph", "insert/pack/dense",
     "nve/sphere/omp", "ave/chunk", "ave/atom", "ave/histo", "ave/correlate", "deform", "rigid", "rigid/small", "spring", "langevin",
@@ -840,7 +840,7 @@ const DEMX_FIX_STYLES: &[&str] = &[
     "wall/gran", "wall/gran/region", "mesh/surface", "mesh/surface/planar", "move/mesh", "insert/pack", "insert/stream",
     "insert/rate/region", "particletemplate/sphere", "particledistribution/discrete", "pour", "aeolian/wind", "nve/sphere",
     "nve", "gravity", "freeze", "addforce", "setforce", "viscous", "print", "ave/time", "property/global", "property/atom",
-    "heat/gran", "heat/gran/conduction",
+    "heat/gran", "heat/gran/conduction", "mesh/surface/stress",
 ];
 
 /// Fixes that need geometry, insertion or wind machinery; everything else
@@ -848,7 +848,9 @@ const DEMX_FIX_STYLES: &[&str] = &[
 pub fn extended_fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
     match style.text.as_str() {
         "wall/gran" if !a.rest().iter().any(|w| w.text == "mesh") => super::walls::wall_gran(s, cmd, id, group, style, a),
-        "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "move/mesh" => super::mesh::fix(s, cmd, id, group, style, a, vars),
+        "wall/gran" | "wall/gran/region" | "mesh/surface" | "mesh/surface/planar" | "mesh/surface/stress" | "move/mesh" => {
+            super::mesh::fix(s, cmd, id, group, style, a, vars)
+        }
         "aeolian/wind" => super::wind::fix(s, cmd, id, group, style, a, vars),
         "heat/gran" | "heat/gran/conduction" => super::heat::fix(s, cmd, id, group, style, a),
         t if ENGINE_FIX_STYLES.contains(&t) || DEMX_FIX_STYLES.contains(&t) || t.starts_with("insert/") || t.starts_with("particle") || t == "adapt" => {
