@@ -146,15 +146,6 @@ dump_modify d sort id format \"%d %.15g %.15g %.15g %.15g %.15g %.15g %.15g %.15
     }
 }
 
-fn deck_error(deck: &str) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("in.deck"), deck).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck", "--log", "none"]).current_dir(dir.path()).output().unwrap();
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    err
-}
-
 /// Missing materials, unknown properties and wrong columns name their line.
 #[test]
 fn bad_heat_commands_are_deck_errors() {
@@ -162,21 +153,18 @@ fn bad_heat_commands_are_deck_errors() {
     let line = |deck: &str| deck.lines().count();
     // no thermalCapacity
     let deck = format!("{base}fix ftco all property/global thermalConductivity peratomtype 100. 20.\nfix h all heat/gran initial_temperature 300.\n");
-    let err = deck_error(&deck);
+    let err = common::deck_error(&deck);
     assert!(err.contains(&format!("in.deck:{}:", line(&deck))) && err.contains("thermalCapacity"), "{err}");
     // a property no fix defines
     let deck = format!("{base}set group all property/atom Temp 800.\n");
-    let err = deck_error(&deck);
+    let err = common::deck_error(&deck);
     assert!(err.contains(&format!("in.deck:{}:", line(&deck))) && err.contains("no per-atom property 'Temp'"), "{err}");
     // Temp has one value per atom: [1] is not a column
     let deck = format!("{base}{MATERIALS}fix h all heat/gran initial_temperature 300.\ndump d all custom 10 d.txt id f_Temp[1]\n");
-    let err = deck_error(&deck);
+    let err = common::deck_error(&deck);
     assert!(err.contains(&format!("in.deck:{}:", line(&deck))) && err.contains("f_Temp[0]"), "{err}");
     // area_correction needs youngsModulusOriginal: not run yet (exit 3)
     let deck = format!("{base}{MATERIALS}fix h all heat/gran initial_temperature 300. area_correction yes\n");
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("in.deck"), &deck).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck", "--log", "none"]).current_dir(dir.path()).output().unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.code() == Some(3) && err.contains("area_correction"), "{err}");
+    let (code, err) = common::demx_deck(&deck, &[]);
+    assert!(code == Some(3) && err.contains("area_correction"), "{err}");
 }

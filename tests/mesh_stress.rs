@@ -3,8 +3,6 @@
 
 mod common;
 
-use std::process::Command;
-
 /// A square plate of two triangles at z = 0.
 const PLATE: &str = "solid plate\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.004 0 0\nvertex 0.004 0.004 0\n\
 endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.004 0.004 0\nvertex 0 0.004 0\nendloop\nendfacet\nendsolid plate\n";
@@ -69,13 +67,7 @@ fn force_and_torque_on_a_plate_follow_liggghts() {
 /// plain mesh/surface are deck errors; wear is not run yet.
 #[test]
 fn stress_off_and_bad_keywords() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("plate.stl"), PLATE).unwrap();
-    let run = |deck: &str| {
-        std::fs::write(dir.path().join("in.deck"), deck).unwrap();
-        let o = Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck", "--log", "none"]).current_dir(dir.path()).output().unwrap();
-        (o.status.code(), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
-    };
+    let run = |deck: &str| common::demx_deck(deck, &[("plate.stl", PLATE)]);
     let (code, out) = run(&deck(" stress off", "run 1300\n"));
     assert_eq!(code, Some(0), "{out}");
     assert!(rows(&out).iter().all(|r| r[2..8].iter().all(|&v| v == 0.0)) && rows(&out).iter().any(|r| r[1] < 1.0e-6), "{out}");

@@ -7,7 +7,6 @@
 
 mod common;
 
-use std::process::Command;
 
 /// 480 spheres on an fcc lattice, two types of different size and density.
 const LJ: &str = "units lj\natom_style sphere\nboundary p p f\ncomm_modify vel yes\nlattice fcc 1.0\n\
@@ -85,24 +84,16 @@ fn rotation_zeroed_in_principal_axes_follows_lammps() {
     }
 }
 
-fn check_error(deck: &str) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("in.deck"), deck).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck", "--log", "none"]).current_dir(dir.path()).output().unwrap();
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    err
-}
 
 #[test]
 fn bad_velocity_commands_are_deck_errors() {
     let line = LJ.lines().count() + 1;
-    let err = check_error(&format!("{LJ}velocity all create 1.0 0\n{DUMP}"));
+    let err = common::deck_error(&format!("{LJ}velocity all create 1.0 0\n{DUMP}"));
     assert!(err.contains(&format!("in.deck:{line}:")) && err.contains("seed 0 must be a positive integer"), "{err}");
-    let err = check_error(&format!("{LJ}velocity all scale 1.0\n{DUMP}"));
+    let err = common::deck_error(&format!("{LJ}velocity all scale 1.0\n{DUMP}"));
     assert!(err.contains(&format!("in.deck:{line}:")) && err.contains("cannot rescale a temperature of 0"), "{err}");
     // IDs 1..N with a gap: loop all cannot hand the draws out by ID
-    let err = check_error(&format!("{LJ}group one id 7\ndelete_atoms group one compress no\nvelocity all create 1.0 87287\n{DUMP}"));
+    let err = common::deck_error(&format!("{LJ}group one id 7\ndelete_atoms group one compress no\nvelocity all create 1.0 87287\n{DUMP}"));
     assert!(err.contains(&format!("in.deck:{}:", line + 2)) && err.contains("consecutive") && err.contains("loop geom"), "{err}");
 }
 

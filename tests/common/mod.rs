@@ -77,3 +77,22 @@ pub fn thermo_runs(out: &str) -> Vec<Vec<Vec<String>>> {
     }
     runs
 }
+
+/// Runs `demx run in.deck --log none` on `deck` (and `files`) in a fresh
+/// directory: its exit code and its output, stdout then stderr.
+pub fn demx_deck(deck: &str, files: &[(&str, &str)]) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("in.deck"), deck).unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_demx")).args(["run", "in.deck", "--log", "none"]).current_dir(dir.path()).output().unwrap();
+    (o.status.code(), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
+}
+
+/// [`demx_deck`] on a deck that must stop as a deck error (exit 2): its output.
+pub fn deck_error(deck: &str) -> String {
+    let (code, out) = demx_deck(deck, &[]);
+    assert_eq!(code, Some(2), "{out}");
+    out
+}
