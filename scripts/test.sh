@@ -23,8 +23,11 @@ for e in liggghts lmp; do
 # a rank that mpirun starts has mpirun's session: run it as it is
 [ -n "\$OMPI_COMM_WORLD_SIZE" ] && exec "$real" "\$@"
 out=\$(mktemp); err=\$(mktemp)
+# line-buffered: an engine's "ERROR on proc 0" line is written before MPI_Abort ends it
+# (fully buffered into a file, LIGGGHTS 3.8 lost it and a failing test
+# showed only Open MPI's banner)
 for try in 1 2 3 4 5; do
-    "$real" "\$@" > "\$out" 2> "\$err"
+    stdbuf -oL "$real" "\$@" > "\$out" 2> "\$err"
     rc=\$?
     [ \$rc -ne 0 ] && grep -qs "unable to create the desired directory" "\$out" "\$err" || break
     # the racers wait different times (their pids)
