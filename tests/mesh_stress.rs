@@ -64,7 +64,7 @@ fn force_and_torque_on_a_plate_follow_liggghts() {
 }
 
 /// `stress off` sums nothing; the keywords of mesh/surface/stress on a
-/// plain mesh/surface are deck errors; wear is not run yet.
+/// plain mesh/surface are deck errors, and so is wear without k_finnie.
 #[test]
 fn stress_off_and_bad_keywords() {
     let run = |deck: &str| common::demx_deck(deck, &[("plate.stl", PLATE)]);
@@ -76,5 +76,5 @@ fn stress_off_and_bad_keywords() {
     let (code, out) = run(&plain);
     assert!(code == Some(2) && out.contains(&format!("in.deck:{line}:")) && out.contains("belongs to fix mesh/surface/stress"), "{out}");
     let (code, out) = run(&deck(" wear finnie", "run 10\n"));
-    assert!(code == Some(3) && out.contains("wear finnie"), "{out}");
+    assert!(code == Some(2) && out.contains("wear finnie needs the property k_finnie") && out.contains("peratomtypepair 1"), "{out}");
 }

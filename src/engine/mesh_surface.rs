@@ -54,6 +54,9 @@ pub struct SurfaceMesh {
     pub corner_active: Vec<[bool; 3]>,
     /// Sorted ids of the coplanar triangles sharing an edge or a node.
     pub coplanar: Vec<Vec<u32>>,
+    /// How many triangles share an edge with each (LIGGGHTS `nNeighs`,
+    /// `dump mesh/vtk ... nneighs`).
+    pub nneighs: Vec<u32>,
     /// cos of the `curvature` angle.
     pub curvature_cos: f64,
     /// Rigid motion and the time it started (`fix move/mesh`).
@@ -85,6 +88,119 @@ pub struct StressSum {
     pub force: V3,
     /// Torque on the mesh about the reference point.
     pub torque: V3,
+    /// The push on each triangle, kept only when a `dump mesh/vtk` reads
+    /// the mesh's stresses.
+    pub per_tri: Option<TriStress>,
+    /// Finnie's wear of each triangle (`wear finnie`).
+    pub wear: Option<Wear>,
+}
+
+/// Finnie's wear of each triangle of a mesh (LIGGGHTS `fix
+/// mesh/surface/stress ... wear finnie`): each contact of a grain of the
+/// fix's group adds [`finnie_increment`] to its triangle's sum of the step,
+/// which the engine adds to the triangle's wear at the step's
+/// final_integrate. The sum of a run's setup is cleared at the first step
+/// without being added. demx adds a step's sum when the next step clears
+/// it, and reads the wear as the total plus the sum of a finished step.
+#[derive(Clone, Debug, Default)]
+pub struct Wear {
+    /// Group bit of the grains that wear the mesh.
+    pub group: u32,
+    /// `k_finnie` of the mesh's type against each atom type (index type - 1).
+    pub k: Vec<f64>,
+    /// This step's wear of each triangle.
+    pub step: Vec<f64>,
+    /// Wear of each triangle up to the last cleared step.
+    pub total: Vec<f64>,
+    /// `step` holds a finished step's wear (not a setup's).
+    pub live: bool,
+}
+
+impl Wear {
+    /// No wear yet on `n` triangles.
+    pub fn new(group: u32, k: Vec<f64>, n: usize) -> Wear {
+        Wear { group, k, step: vec![0.0; n], total: vec![0.0; n], live: false }
+    }
+
+    /// Each triangle's wear as the engine holds it after the step.
+    pub fn current(&self) -> Vec<f64> {
+        if self.live {
+            self.total.iter().zip(&self.step).map(|(t, s)| t + s).collect()
+        } else {
+            self.total.clone()
+        }
+    }
+
+    /// Start a step's (or a setup's) sums: a finished step's go into the
+    /// totals, a setup's are dropped.
+    pub fn clear(&mut self) {
+        if self.live {
+            for (t, s) in self.total.iter_mut().zip(&self.step) {
+                *t += s;
+            }
+        }
+        self.step.fill(0.0);
+        self.live = false;
+    }
+}
+
+/// Finnie's wear of one contact in one step, per unit area (LIGGGHTS
+/// `MeshModuleStress::add_particle_contribution`, after Finnie 1960): with
+/// γ the angle between the grain's velocity relative to the wall `v_rel`
+/// and the face (unit normal `n`), E = sin 2γ - 3 sin²γ where tan γ <= 1/3
+/// and cos²γ/3 (0.33333 in the engine) above, times 2 k |v_rel| |F| dt /
+/// area. Zero while the grain moves away from its contact point (`c`, from
+/// its centre) or below a relative speed of 1e-7.
+#[allow(clippy::too_many_arguments)]
+pub fn finnie_increment(c: V3, v_rel: V3, n: V3, k: f64, force: f64, dt: f64, area: f64) -> f64 {
+    if c.dot(&v_rel) < 0.0 {
+        return 0.0;
+    }
+    let speed = v_rel.norm();
+    if speed < 1e-7 {
+        return 0.0;
+    }
+    let sin_g = (v_rel.dot(&n).abs() / speed).min(1.0);
+    let cos_g = (v_rel.cross(&n).norm() / speed).min(1.0);
+    let e = if cos_g < 1e-4 || 3.0 * sin_g > cos_g { 0.33333 * cos_g * cos_g } else { 2.0 * sin_g * cos_g - 3.0 * sin_g * sin_g };
+    e * (2.0 * k * speed * force) * dt / area
+}
+
+/// The push of the grains on each triangle of a mesh (LIGGGHTS's element
+/// properties `f`, `sigma_n` and `sigma_t` of mesh/surface/stress).
+///
+/// The engine clears `f` at a run's setup and at every step's head, adds
+/// each contact's push during the wall forces, and derives the stresses
+/// from `f` at the step's final_integrate alone: a dump at a run's setup
+/// shows the setup's `f` beside the stresses of the step before. demx
+/// derives them when they are read, from `f` while `live`, and keeps them
+/// in `sigma` when a setup clears `f`.
+#[derive(Clone, Debug, Default)]
+pub struct TriStress {
+    /// Force of the grains of the fix's group on each triangle.
+    pub f: Vec<V3>,
+    /// Normal and shear stress of each triangle when not `live`.
+    pub sigma: Vec<[f64; 2]>,
+    /// The stresses are those of `f` (a step's walls have added to it).
+    pub live: bool,
+}
+
+impl TriStress {
+    /// Zeroed sums for `n` triangles.
+    pub fn new(n: usize) -> TriStress {
+        TriStress { f: vec![V3::zeros(); n], sigma: vec![[0.0; 2]; n], live: false }
+    }
+}
+
+/// Normal and shear stress of a triangle pushed by `f`, with unit normal
+/// `n` and area `a`: |f.n|/a and |f - (f.n) n|/a (LIGGGHTS
+/// `MeshModuleStress::calc_total_force`; absolute values since a mesh's
+/// normal may point either way).
+pub fn stresses(f: V3, n: V3, a: f64) -> [f64; 2] {
+    let fn_ = f.dot(&n);
+    let ft = f - n * fn_;
+    let inv = 1.0 / a;
+    [fn_.abs() * inv, ft.norm() * inv]
 }
 
 fn bits(v: V3) -> [u64; 3] {
@@ -217,6 +333,7 @@ impl SurfaceMesh {
             }
         }
         // coplanar neighbours sharing an edge or a node
+        let nneighs = edge_neigh.iter().map(|e| e.len() as u32).collect();
         let mut coplanar = vec![Vec::new(); n];
         for t in 0..n {
             let mut c: Vec<u32> = Vec::new();
@@ -241,7 +358,7 @@ impl SurfaceMesh {
             }).sum::<f64>() / n as f64
         };
         let bins = TriangleBins::new(&mesh, cell);
-        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, curvature_cos, motion: None, surface_vel: None, moving: false, epoch: 0, stress: None }
+        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, nneighs, curvature_cos, motion: None, surface_vel: None, moving: false, epoch: 0, stress: None }
     }
 
     /// Whether all triangles lie in one plane within the curvature
@@ -305,6 +422,45 @@ impl SurfaceMesh {
             }
         }
         v
+    }
+
+    /// Normal and shear stress of each triangle at `time` (None unless a
+    /// `dump mesh/vtk` keeps the pushes per triangle).
+    pub fn tri_stresses(&self, time: f64) -> Option<Vec<[f64; 2]>> {
+        let ts = self.stress.as_ref()?.per_tri.as_ref()?;
+        if !ts.live {
+            return Some(ts.sigma.clone());
+        }
+        Some(self.tris.iter().zip(&ts.f).map(|(t, &f)| stresses(f, self.dir_to_world(t.n, time), t.area())).collect())
+    }
+
+    /// Clear the pushes (and the wear sums) per triangle: at each step's
+    /// head, and at a run's setup (`setup`), which keeps the last step's
+    /// stresses.
+    pub fn clear_tri_push(&mut self, time: f64, setup: bool) {
+        if setup {
+            if let Some(sigma) = self.tri_stresses(time) {
+                if let Some(ts) = self.stress.as_mut().and_then(|s| s.per_tri.as_mut()) {
+                    (ts.sigma, ts.live) = (sigma, false);
+                }
+            }
+        }
+        if let Some(ts) = self.stress.as_mut().and_then(|s| s.per_tri.as_mut()) {
+            ts.f.fill(V3::zeros());
+        }
+        if let Some(w) = self.stress.as_mut().and_then(|s| s.wear.as_mut()) {
+            w.clear();
+        }
+    }
+
+    /// Velocity of each triangle's nodes at `time` (None for a mesh that
+    /// neither moves nor has a surface velocity: LIGGGHTS gives such a mesh
+    /// no `v` property).
+    pub fn node_velocities(&self, time: f64) -> Option<Vec<[V3; 3]>> {
+        if self.motion.is_none() && self.surface_vel.is_none() {
+            return None;
+        }
+        Some((0..self.tris.len()).map(|t| self.tris[t].v.map(|p| self.wall_velocity(self.to_world(p, time), t, time))).collect())
     }
 
     /// Triangles at `time` as plain arrays (for `dump mesh/stl`).

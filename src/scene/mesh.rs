@@ -15,10 +15,11 @@ use super::Session;
 use crate::engine::fix::{Fix, Hook, Local};
 use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::integrate::CHUNK;
-use crate::engine::mesh_surface::{resolve_among, resolve_particle, MeshHit, SharedMesh, Slots, StressSum, SurfaceMesh, DEFAULT_CURVATURE_COS, MESH_SLOTS};
+use crate::engine::mesh_surface::{finnie_increment, resolve_among, resolve_particle, MeshHit, SharedMesh, Slots, StressSum, SurfaceMesh, TriStress, Wear, DEFAULT_CURVATURE_COS, MESH_SLOTS};
 use crate::engine::output::Dump;
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
+use crate::io::vtk::{MeshArray, MeshVtkOutput, VtkType};
 use crate::geom::mesh::parse_mesh_transforms;
 use crate::geom::{MeshMotion, Region, Triangle};
 use crate::physics::{Contact, V3};
@@ -66,12 +67,19 @@ impl Fix for MeshSurfaceFix {
     fn local(&mut self, hook: Hook, _sim: &Sim, _vars: &Variables) -> Result<Local> {
         Ok(if hook == Hook::InitialIntegrate && self.stressed() { Local::Whole } else { Local::Nothing })
     }
-    fn initial_integrate(&mut self, _sim: &mut Sim) {
+    fn initial_integrate(&mut self, sim: &mut Sim) {
         if let Ok(mut m) = self.mesh.write() {
             if let Some(st) = m.stress.as_mut() {
                 (st.force, st.torque) = (V3::zeros(), V3::zeros());
             }
+            m.clear_tri_push(sim.time, false);
         }
+    }
+    /// The pushes per triangle (kept for `dump mesh/vtk`) are cleared at a
+    /// run's setup too (the engine's `FixMesh::setup_pre_force`).
+    fn setup(&mut self, sim: &mut Sim) -> Result<()> {
+        self.mesh.write().map_err(|_| lock_err())?.clear_tri_push(sim.time, true);
+        Ok(())
     }
     /// `f_ID[1..9]` of mesh/surface/stress: the force on the mesh, its
     /// torque about the reference point, and that point (where the mesh
@@ -139,6 +147,7 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Wo
     let mut transforms = Vec::new();
     // mesh/surface/stress sums the grains' push unless `stress off`
     let mut stress = style.text == "mesh/surface/stress";
+    let mut wear: Option<&Word> = None;
     let mut p_ref = V3::zeros();
     let words = a.rest();
     let mut i = 0;
@@ -226,7 +235,7 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Wo
                 let w = word(i + 1, "finnie or off")?;
                 match w.text.as_str() {
                     "off" => {}
-                    "finnie" => return Err(Error::unsupported(w.span, "fix mesh/surface/stress wear finnie")),
+                    "finnie" => wear = Some(w),
                     _ => return Err(args::bad_keyword(w, "wear", &["finnie", "off"])),
                 }
                 i += 2;
@@ -309,7 +318,24 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Wo
     if style.text == "mesh/surface/stress" {
         // `stress off`: no grain counts, the sums stay zero (the engine's
         // f_ID then reads zeros too)
-        mesh.stress = Some(StressSum { group: if stress { group } else { 0 }, p_ref, ..Default::default() });
+        let n = mesh.tris.len();
+        let wear = match wear {
+            None => None,
+            // k_finnie[mesh type][atom type], a peratomtypepair property
+            // stored as [N, v11, v12, ...]
+            Some(w) => match s.props.get("k_finnie") {
+                Some((_, v)) if v.len() > 1 && v[0] as usize == s.sim.ntypes && (wall_type as usize) <= s.sim.ntypes => {
+                    let nt = s.sim.ntypes;
+                    let row = 1 + (wall_type as usize - 1) * nt;
+                    Some(Wear::new(group, v[row..row + nt].to_vec(), n))
+                }
+                _ => {
+                    return Err(Error::deck(w.span, "fix mesh/surface/stress wear finnie needs the property k_finnie")
+                        .with_hint(format!("define it first: fix ID all property/global k_finnie peratomtypepair {} VALUES...", s.sim.ntypes)))
+                }
+            },
+        };
+        mesh.stress = Some(StressSum { group: if stress { group } else { 0 }, p_ref, wear, ..Default::default() });
     }
     if style.text == "mesh/surface/planar" && !mesh.is_planar() {
         return Err(Error::deck(file.span, format!("fix mesh/surface/planar: mesh '{}' is not planar", file.text)));
@@ -459,7 +485,8 @@ impl Fix for WallGranMesh {
         let len = self.slot_len();
         let time = sim.time;
         // dt = 0 leaves the history where it is (setup force evaluation)
-        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
+        let setup = std::mem::take(&mut self.in_setup);
+        let dt = if setup { 0.0 } else { sim.dt };
         let ns = &sim.neigh;
         let steady = sim.pairs.x_built.len() == sim.particles.len() && ns.check && ns.delay == 0 && ns.every <= 1;
         let (builds, skin) = (sim.pairs.builds, ns.skin);
@@ -512,10 +539,14 @@ impl Fix for WallGranMesh {
             // mesh/surface/stress: the grains of its group push the mesh
             // back; its reference point where the mesh is now
             let stress = mesh.stress.as_ref().map(|st| (st.group, mesh.to_world(st.p_ref, time)));
-            // each chunk's push on the mesh, summed in chunk order below:
-            // the same bits on any thread count
-            let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Result<(V3, V3)> {
-                let (mut push, mut moment) = (V3::zeros(), V3::zeros());
+            // the push on each triangle too, where a dump reads it
+            let per_tri = mesh.stress.as_ref().is_some_and(|st| st.per_tri.is_some());
+            let wear = mesh.stress.as_ref().and_then(|st| st.wear.as_ref());
+            let step_dt = sim.dt;
+            // each chunk's push on the mesh (and its triangles), summed in
+            // chunk order below: the same bits on any thread count
+            let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Result<ChunkPush> {
+                let (mut push, mut moment, mut tri_push, mut tri_wear) = (V3::zeros(), V3::zeros(), Vec::new(), Vec::new());
                 for q in 0..fc.len() {
                     let i = c * CHUNK + q;
                     if mask[i] & group == 0 {
@@ -526,6 +557,7 @@ impl Fix for WallGranMesh {
                     let pp = table.get(kind[i], mesh.wall_type);
                     let (mut fs, mut ts) = (V3::zeros(), V3::zeros());
                     let pushes = stress.filter(|&(g, _)| mask[i] & g != 0).map(|(_, at)| at);
+                    let wears = wear.filter(|w| mask[i] & w.group != 0).map(|w| w.k[kind[i] as usize - 1]);
                     let slots = Slots { data: &mut hc[q * len..(q + 1) * len], width };
                     let apply = |hit: &MeshHit, hist: &mut [f64]| {
                         let nrm = mesh.dir_to_world(hit.normal, time);
@@ -541,6 +573,14 @@ impl Fix for WallGranMesh {
                             // the contact point is the triangle's point nearest the centre
                             push -= fi;
                             moment += (point - at).cross(&-fi);
+                            if per_tri {
+                                tri_push.push((hit.tri as u32, -fi));
+                            }
+                        }
+                        if let Some(k) = wears {
+                            let t = &mesh.tris[hit.tri];
+                            let n = mesh.dir_to_world(t.n, time);
+                            tri_wear.push((hit.tri as u32, finnie_increment(point - xi, vr, n, k, fi.norm(), step_dt, t.area())));
                         }
                     };
                     if bounded {
@@ -552,22 +592,40 @@ impl Fix for WallGranMesh {
                     fc[q] += fs;
                     tc[q] += ts;
                 }
-                Ok((push, moment))
+                Ok((push, moment, tri_push, tri_wear))
             };
             let data = &mut extra[col].data[..n * len];
-            let done: Vec<Result<(V3, V3)>> = if n >= 2 * CHUNK {
+            let done: Vec<Result<ChunkPush>> = if n >= 2 * CHUNK {
                 f.par_chunks_mut(CHUNK).zip(torque.par_chunks_mut(CHUNK)).zip(data.par_chunks_mut(CHUNK * len)).enumerate().map(body).collect()
             } else {
                 f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * len)).enumerate().map(body).collect()
             };
-            let parts = done.into_iter().collect::<Result<Vec<(V3, V3)>>>()?;
+            let parts = done.into_iter().collect::<Result<Vec<ChunkPush>>>()?;
             if stress.is_some() {
                 drop(guard);
                 let mut m = wm.mesh.write().map_err(|_| lock_err())?;
                 if let Some(st) = m.stress.as_mut() {
-                    for (push, moment) in parts {
+                    for (push, moment, tri_push, tri_wear) in parts {
                         st.force += push;
                         st.torque += moment;
+                        if let Some(ts) = st.per_tri.as_mut() {
+                            for (t, p) in tri_push {
+                                ts.f[t as usize] += p;
+                            }
+                        }
+                        if let Some(w) = st.wear.as_mut() {
+                            for (t, e) in tri_wear {
+                                w.step[t as usize] += e;
+                            }
+                        }
+                    }
+                    if let Some(w) = st.wear.as_mut() {
+                        w.live |= !setup;
+                    }
+                    // the step's stresses are those of these pushes (the
+                    // engine derives them at final_integrate, not at setup)
+                    if let Some(ts) = st.per_tri.as_mut() {
+                        ts.live |= !setup;
                     }
                 }
             }
@@ -729,7 +787,8 @@ impl Fix for WallGranRegion {
         let len = self.slot_len();
         let w = 4 + self.width;
         let col = sim.particles.add_extra(&self.hist_name, vec![0.0; len]);
-        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
+        let setup = std::mem::take(&mut self.in_setup);
+        let dt = if setup { 0.0 } else { sim.dt };
         let p = &mut sim.particles;
         for i in 0..p.len() {
             if p.mask[i] & self.group == 0 {
@@ -867,6 +926,11 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
     }))
 }
 
+/// What one chunk of grains pushes a mesh with: force, its moment about
+/// the reference point, the push on each triangle touched and the wear of
+/// each, in contact order (when kept).
+type ChunkPush = (V3, V3, Vec<(u32, V3)>, Vec<(u32, f64)>);
+
 // ------------------------------------------------------------ dump mesh/stl
 
 /// `dump ID group mesh/stl N file [mesh ids]`: the current (moved) meshes as
@@ -922,7 +986,7 @@ pub fn dump_mesh_stl(s: &Session, cmd: &Command) -> Result<DumpMeshStl> {
     let id = a.word("dump id")?;
     let g = a.word("group")?;
     s.group(g)?;
-    a.choice("dump style", &["mesh/stl"])?;
+    a.choice("dump style", &["mesh/stl", "stl"])?;
     let every = a.i64("N")?;
     if every <= 0 {
         return Err(a.err_prev("dump mesh/stl: N must be > 0"));
@@ -948,4 +1012,226 @@ pub fn dump_mesh_stl(s: &Session, cmd: &Command) -> Result<DumpMeshStl> {
     }
     let summary = format!("dump {} mesh/stl every {every} -> {} (meshes {})", id.text, file.text, names.join(" "));
     Ok(DumpMeshStl { id: id.text.clone(), every, path: file.text.clone(), meshes, last_step: None, summary })
+}
+
+// ------------------------------------------------------------ dump mesh/vtk
+
+/// What `dump mesh/vtk` may write of each triangle, in the order LIGGGHTS
+/// writes the arrays (whatever the order of the command's words).
+const MESH_VTK_PROPS: [&str; 11] = ["stress", "stresscomponents", "id", "vel", "wear", "owner", "area", "aedges", "acorners", "index", "nneighs"];
+
+/// `dump ID group mesh/vtk N file [output face|interpolate|original]
+/// props... [mesh ids...]` (LIGGGHTS 3.8): the meshes as one legacy VTK
+/// polydata file per frame, with the chosen properties of each triangle.
+pub struct DumpMeshVtk {
+    id: String,
+    every: i64,
+    path: String,
+    output: MeshVtkOutput,
+    /// Which of [`MESH_VTK_PROPS`] are written.
+    props: [bool; 11],
+    meshes: Vec<SharedMesh>,
+    last_step: Option<i64>,
+    summary: String,
+}
+
+impl DumpMeshVtk {
+    fn wants(&self, prop: &str) -> bool {
+        MESH_VTK_PROPS.iter().position(|&p| p == prop).is_some_and(|k| self.props[k])
+    }
+
+    /// One mesh's triangle and node arrays, as LIGGGHTS's `DumpMesh`
+    /// builds them: a property the mesh does not have (stresses of a mesh
+    /// without mesh/surface/stress, velocities of a mesh at rest, wear) is
+    /// left out.
+    fn arrays(&self, m: &SurfaceMesh, time: f64) -> (Vec<MeshArray>, Vec<MeshArray>) {
+        let n = m.tris.len();
+        let (mut cells, mut nodes) = (Vec::new(), Vec::new());
+        let arr = |name: &str, ncomp: usize, ty: VtkType, values: Vec<f64>| MeshArray { name: name.to_string(), ncomp, ty, values };
+        let ints = |f: &dyn Fn(usize) -> usize| (0..n).map(|t| f(t) as f64).collect::<Vec<f64>>();
+        if self.wants("stress") {
+            if let Some(sigma) = m.tri_stresses(time) {
+                cells.push(arr("normal_stress_average", 1, VtkType::Double, sigma.iter().map(|s| s[0]).collect()));
+                cells.push(arr("shear_stress_average", 1, VtkType::Double, sigma.iter().map(|s| s[1]).collect()));
+            }
+        }
+        if self.wants("stresscomponents") {
+            if let Some(ts) = m.stress.as_ref().and_then(|st| st.per_tri.as_ref()) {
+                // the push over the area, as the engine's f * (1/area)
+                let values = m.tris.iter().zip(&ts.f).flat_map(|(t, f)| {
+                    let inv = 1.0 / t.area();
+                    [f.x * inv, f.y * inv, f.z * inv]
+                });
+                cells.push(arr("stress", 3, VtkType::Double, values.collect()));
+            }
+        }
+        if self.wants("id") {
+            cells.push(arr("meshid", 1, VtkType::Int, ints(&|t| t)));
+        }
+        if self.wants("vel") {
+            if let Some(v) = m.node_velocities(time) {
+                nodes.push(arr("v", 3, VtkType::Double, v.iter().flatten().flat_map(|p| [p.x, p.y, p.z]).collect()));
+            }
+        }
+        if self.wants("wear") {
+            if let Some(w) = m.stress.as_ref().and_then(|st| st.wear.as_ref()) {
+                cells.push(arr("wear", 1, VtkType::Double, w.current()));
+            }
+        }
+        if self.wants("owner") {
+            cells.push(arr("owner", 1, VtkType::Int, vec![0.0; n]));
+        }
+        if self.wants("area") {
+            cells.push(arr("area", 1, VtkType::Double, m.tris.iter().map(|t| t.area()).collect()));
+        }
+        if self.wants("aedges") {
+            cells.push(arr("active_edges", 1, VtkType::Int, ints(&|t| m.edge_active[t].iter().filter(|&&a| a).count())));
+        }
+        if self.wants("acorners") {
+            cells.push(arr("active_corners", 1, VtkType::Int, ints(&|t| m.corner_active[t].iter().filter(|&&a| a).count())));
+        }
+        if self.wants("index") {
+            cells.push(arr("index", 1, VtkType::Int, ints(&|t| t)));
+        }
+        if self.wants("nneighs") {
+            cells.push(arr("nneighs", 1, VtkType::Int, ints(&|t| m.nneighs[t] as usize)));
+        }
+        (cells, nodes)
+    }
+}
+
+/// The arrays of several meshes as one: each name where it first appears,
+/// its values mesh after mesh, zeros for a mesh without it (as LIGGGHTS
+/// merges its meshes' blocks). `per` is each mesh's tuple count.
+fn merge_arrays(blocks: Vec<Vec<MeshArray>>, per: &[usize]) -> Vec<MeshArray> {
+    let mut out: Vec<MeshArray> = Vec::new();
+    for b in &blocks {
+        for a in b {
+            if !out.iter().any(|o| o.name == a.name) {
+                out.push(MeshArray { values: Vec::new(), ..a.clone() });
+            }
+        }
+    }
+    for o in &mut out {
+        for (b, &count) in blocks.iter().zip(per) {
+            match b.iter().find(|a| a.name == o.name) {
+                Some(a) => o.values.extend_from_slice(&a.values),
+                None => o.values.extend(std::iter::repeat_n(0.0, count * o.ncomp)),
+            }
+        }
+    }
+    out
+}
+
+impl Dump for DumpMeshVtk {
+    fn due(&self, step: i64, first: bool) -> bool {
+        if self.last_step == Some(step) {
+            return false;
+        }
+        (self.every > 0 && step % self.every == 0) || first
+    }
+    fn write(&mut self, sim: &Sim) -> Result<()> {
+        if sim.dry {
+            return Ok(());
+        }
+        self.last_step = Some(sim.step);
+        let (mut tris, mut cells, mut nodes, mut ntri, mut nnode) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for m in &self.meshes {
+            let m = m.read().map_err(|_| lock_err())?;
+            tris.extend(m.current_triangles(sim.time));
+            let (c, p) = self.arrays(&m, sim.time);
+            cells.push(c);
+            nodes.push(p);
+            ntri.push(m.tris.len());
+            nnode.push(3 * m.tris.len());
+        }
+        let text = crate::io::vtk::format_mesh_vtk(&tris, merge_arrays(cells, &ntri), merge_arrays(nodes, &nnode), self.output);
+        let path = self.path.replace('*', &sim.step.to_string());
+        crate::io::write_atomic(&path, text.as_bytes())
+            .map_err(|e| Error::runtime(format!("dump {}: cannot write '{path}': {e}", self.id)))
+    }
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn modify(&mut self, args: &[Word]) -> Result<()> {
+        match args.first() {
+            Some(w) => Err(Error::unsupported(w.span, format!("dump_modify {} for dump mesh/vtk", w.text))),
+            None => Ok(()),
+        }
+    }
+    fn summary(&self) -> String {
+        self.summary.clone()
+    }
+}
+
+/// Parse `dump ID group mesh/vtk N file [output face|interpolate|original]
+/// props... [mesh ids...]` (all meshes when no id is given; the group is
+/// not read, as in LIGGGHTS). A mesh/surface/stress mesh whose stresses
+/// are dumped keeps its pushes per triangle from now on.
+pub fn dump_mesh_vtk(s: &Session, cmd: &Command) -> Result<DumpMeshVtk> {
+    let mut a = Args::new(cmd);
+    let id = a.word("dump id")?;
+    let g = a.word("group")?;
+    s.group(g)?;
+    a.choice("dump style", &["mesh/vtk", "mesh/gran/VTK"])?;
+    let every = a.i64("N")?;
+    if every <= 0 {
+        return Err(a.err_prev("dump mesh/vtk: N must be > 0"));
+    }
+    let file = a.word("file")?;
+    if file.text.ends_with(".vtp") || file.text.ends_with(".pvtp") {
+        return Err(Error::unsupported(file.span, "dump mesh/vtk to a .vtp or .pvtp file (XML); demx writes legacy .vtk"));
+    }
+    let mut output = MeshVtkOutput::Face;
+    let mut props = [false; 11];
+    let (mut meshes, mut names) = (Vec::new(), Vec::new());
+    while a.more() {
+        let w = a.word("mesh/vtk keyword")?;
+        if w.text == "output" {
+            let m = a.choice("output", &["face", "interpolate", "original"])?;
+            output = match m.text.as_str() {
+                "face" => MeshVtkOutput::Face,
+                "interpolate" => MeshVtkOutput::Interpolate,
+                _ => MeshVtkOutput::Original,
+            };
+        } else if let Some(m) = find_mesh(s, &w.text) {
+            meshes.push(m);
+            names.push(w.text.clone());
+        } else if let Some(k) = MESH_VTK_PROPS.iter().position(|&p| p == w.text) {
+            props[k] = true;
+        } else if ["temp", "distaa", "liquid"].contains(&w.text.as_str()) {
+            return Err(Error::unsupported(w.span, format!("dump mesh/vtk property {}", w.text)));
+        } else {
+            let mut e = Error::deck(w.span, format!("dump mesh/vtk: '{}' is neither a property nor a fix mesh/surface", w.text));
+            let known = MESH_VTK_PROPS.iter().copied().chain(s.sim.fixes.iter().filter(|f| f.style().starts_with("mesh/surface")).map(|f| f.id()));
+            if let Some(h) = crate::error::did_you_mean(&w.text, known) {
+                e = e.with_hint(format!("did you mean '{h}'?"));
+            }
+            return Err(e);
+        }
+    }
+    if !props.iter().any(|&p| p) {
+        return Err(Error::deck(cmd.span, "dump mesh/vtk: no property to dump").with_hint(format!("name one or more of: {}", MESH_VTK_PROPS.join(" "))));
+    }
+    if meshes.is_empty() {
+        for f in &s.sim.fixes {
+            if let Some(m) = f.as_any().and_then(|x| x.downcast_ref::<MeshSurfaceFix>()) {
+                meshes.push(m.mesh.clone());
+                names.push(m.id.clone());
+            }
+        }
+    }
+    let d = DumpMeshVtk { id: id.text.clone(), every, path: file.text.clone(), output, props, meshes, last_step: None, summary: String::new() };
+    if d.wants("stress") || d.wants("stresscomponents") {
+        for m in &d.meshes {
+            let mut m = m.write().map_err(|_| lock_err())?;
+            let n = m.tris.len();
+            if let Some(st) = m.stress.as_mut() {
+                st.per_tri.get_or_insert_with(|| TriStress::new(n));
+            }
+        }
+    }
+    let chosen: Vec<&str> = MESH_VTK_PROPS.iter().zip(props).filter(|&(_, on)| on).map(|(&p, _)| p).collect();
+    let summary = format!("dump {} mesh/vtk every {every} -> {} ({}; meshes {})", id.text, file.text, chosen.join(" "), names.join(" "));
+    Ok(DumpMeshVtk { summary, ..d })
 }

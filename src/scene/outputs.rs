@@ -549,7 +549,9 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             (DumpOptions::custom(engine, every.max(0) as u64, &refs), cols)
         }
         "atom" | "atom/gz" => (DumpOptions::atom(engine, every.max(0) as u64), vec![]),
-        "mesh/stl" => {
+        // `stl` and `mesh/gran/VTK` are LIGGGHTS 3.8's own aliases (its
+        // DumpStyle lines), kept from 2.x
+        "mesh/stl" | "stl" => {
             if s.sim.dumps.iter().any(|x| x.id() == id.text) {
                 return Err(Error::deck(id.span, format!("dump '{}' already exists", id.text)).with_hint("undump it first"));
             }
@@ -557,10 +559,18 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             s.sim.dumps.push(Box::new(d));
             return Ok(());
         }
-        "mesh/vtk" | "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "stl" | "mesh/gran/VTK" | "vtk" | "decomposition/vtk" | "euler/vtk" => {
+        "mesh/vtk" | "mesh/gran/VTK" => {
+            if s.sim.dumps.iter().any(|x| x.id() == id.text) {
+                return Err(Error::deck(id.span, format!("dump '{}' already exists", id.text)).with_hint("undump it first"));
+            }
+            let d = super::mesh::dump_mesh_vtk(s, cmd)?;
+            s.sim.dumps.push(Box::new(d));
+            return Ok(());
+        }
+        "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "vtk" | "decomposition/vtk" | "euler/vtk" => {
             return Err(Error::unsupported(style.span, format!("dump {}", style.text)));
         }
-        _ => return Err(bad_keyword(style, "dump style", &["custom", "atom", "custom/vtk", "mesh/stl"])),
+        _ => return Err(bad_keyword(style, "dump style", &["custom", "atom", "custom/vtk", "mesh/stl", "mesh/vtk"])),
     };
     let summary = format!("dump {} {} every {} -> {}", id.text, style.text, every, file.text);
     if s.sim.dumps.iter().any(|x| x.id() == id.text) {
