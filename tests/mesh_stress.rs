@@ -3,29 +3,17 @@
 
 mod common;
 
-/// A square plate of two triangles at z = 0.
-const PLATE: &str = "solid plate\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.004 0 0\nvertex 0.004 0.004 0\n\
-endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.004 0.004 0\nvertex 0 0.004 0\nendloop\nendfacet\nendsolid plate\n";
+/// The plate at z = 0.
+fn plate() -> String {
+    common::plate_stl("0")
+}
 
-/// Nine grains thrown at the plate, the middle column faster and sideways,
-/// so that the two columns hit at different times with friction in x and y.
+/// [`common::plate_deck`] printing the force, torque and reference point of
+/// the plate every 20 steps, then `runs`.
 fn deck(stress: &str, runs: &str) -> String {
-    format!(
-        "units si\natom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\n\
-region box block -0.001 0.005 -0.001 0.005 -0.001 0.004 units box\ncreate_box 1 box\nlattice sc 0.001\n\
-region grains block 0.0005 0.0035 0.0005 0.0035 0.0005 0.0015 units box\ncreate_atoms 1 region grains\n\
-set group all diameter 0.0009 density 2500\n\
-fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
-fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
-fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
-pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\n\
-fix cad all mesh/surface/stress file plate.stl type 1{stress}\n\
-fix wall all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
-fix g all gravity 9.81 vector 0 0 -1\nregion fast block 0.0015 0.0025 INF INF INF INF units box\n\
-velocity all set 0.1 0 -0.5\ngroup fast region fast\nvelocity fast set 0 0.2 -0.8\nfix 1 all nve/sphere\ntimestep 1e-6\n\
-thermo_style custom step ke f_cad[1] f_cad[2] f_cad[3] f_cad[4] f_cad[5] f_cad[6] f_cad[7] f_cad[8] f_cad[9]\n\
-thermo_modify format float %.15g\nthermo 20\n{runs}"
-    )
+    let thermo = "thermo_style custom step ke f_cad[1] f_cad[2] f_cad[3] f_cad[4] f_cad[5] f_cad[6] f_cad[7] f_cad[8] f_cad[9]\n\
+thermo_modify format float %.15g\nthermo 20\n";
+    common::plate_deck(stress, "", &format!("{thermo}{runs}"))
 }
 
 fn rows(out: &str) -> Vec<Vec<f64>> {
@@ -38,7 +26,7 @@ fn rows(out: &str) -> Vec<Vec<f64>> {
 #[test]
 fn force_and_torque_on_a_plate_follow_liggghts() {
     let d = deck(" reference_point 0.001 0.0015 0", "run 1130\nrun 400\n");
-    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &d), ("plate.stl", PLATE)]);
+    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &d), ("plate.stl", &plate())]);
     let (theirs, ours) = (rows(&b.theirs_out), rows(&b.ours_out));
     assert_eq!(theirs.len(), ours.len());
     let mut hits = 0;
@@ -67,7 +55,7 @@ fn force_and_torque_on_a_plate_follow_liggghts() {
 /// plain mesh/surface are deck errors, and so is wear without k_finnie.
 #[test]
 fn stress_off_and_bad_keywords() {
-    let run = |deck: &str| common::demx_deck(deck, &[("plate.stl", PLATE)]);
+    let run = |deck: &str| common::demx_deck(deck, &[("plate.stl", &plate())]);
     let (code, out) = run(&deck(" stress off", "run 1300\n"));
     assert_eq!(code, Some(0), "{out}");
     assert!(rows(&out).iter().all(|r| r[2..8].iter().all(|&v| v == 0.0)) && rows(&out).iter().any(|r| r[1] < 1.0e-6), "{out}");

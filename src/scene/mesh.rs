@@ -933,46 +933,89 @@ type ChunkPush = (V3, V3, Vec<(u32, V3)>, Vec<(u32, f64)>);
 
 // ------------------------------------------------------------ dump mesh/stl
 
-/// `dump ID group mesh/stl N file [mesh ids]`: the current (moved) meshes as
-/// ASCII STL, one file per frame (`*` in the file name becomes the step;
-/// LIGGGHTS requires the `*`).
-pub struct DumpMeshStl {
+/// What the mesh dumps share: id, interval, file pattern (`*` becomes the
+/// step) and the step of the last frame.
+struct MeshFrames {
     id: String,
     every: i64,
     path: String,
-    meshes: Vec<SharedMesh>,
     last_step: Option<i64>,
-    summary: String,
 }
 
-impl Dump for DumpMeshStl {
+impl MeshFrames {
     fn due(&self, step: i64, first: bool) -> bool {
         if self.last_step == Some(step) {
             return false;
         }
         (self.every > 0 && step % self.every == 0) || first
     }
+
+    /// Write one frame's file whole (through a temporary file: a run that
+    /// is killed leaves no half-written frame).
+    fn write(&mut self, step: i64, text: &str) -> Result<()> {
+        self.last_step = Some(step);
+        let path = self.path.replace('*', &step.to_string());
+        crate::io::write_atomic(&path, text.as_bytes()).map_err(|e| Error::runtime(format!("dump {}: {e}", self.id)))
+    }
+
+    fn modify(args: &[Word], style: &str) -> Result<()> {
+        match args.first() {
+            Some(w) => Err(Error::unsupported(w.span, format!("dump_modify {} for dump {style}", w.text))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// `dump ID group STYLE N file` of a mesh dump (the group is checked, not
+/// read, as in LIGGGHTS): its frames and the arguments after the file.
+fn mesh_dump_head<'c>(s: &Session, cmd: &'c Command, styles: &[&str]) -> Result<(MeshFrames, &'c Word, Args<'c>)> {
+    let mut a = Args::new(cmd);
+    let id = a.word("dump id")?;
+    let g = a.word("group")?;
+    s.group(g)?;
+    a.choice("dump style", styles)?;
+    let every = a.i64("N")?;
+    if every <= 0 {
+        return Err(a.err_prev(&format!("dump {}: N must be > 0", styles[0])));
+    }
+    let file = a.word("file")?;
+    Ok((MeshFrames { id: id.text.clone(), every, path: file.text.clone(), last_step: None }, file, a))
+}
+
+/// Every mesh of the scene, in the order of their fixes, with their ids
+/// (a mesh dump without mesh ids writes them all).
+fn all_meshes(s: &Session) -> (Vec<SharedMesh>, Vec<String>) {
+    s.sim.fixes.iter().filter_map(|f| f.as_any().and_then(|x| x.downcast_ref::<MeshSurfaceFix>())).map(|m| (m.mesh.clone(), m.id.clone())).unzip()
+}
+
+/// `dump ID group mesh/stl N file [mesh ids]`: the current (moved) meshes as
+/// ASCII STL, one file per frame (`*` in the file name becomes the step;
+/// LIGGGHTS requires the `*`).
+pub struct DumpMeshStl {
+    frames: MeshFrames,
+    meshes: Vec<SharedMesh>,
+    summary: String,
+}
+
+impl Dump for DumpMeshStl {
+    fn due(&self, step: i64, first: bool) -> bool {
+        self.frames.due(step, first)
+    }
     fn write(&mut self, sim: &Sim) -> Result<()> {
         if sim.dry {
             return Ok(());
         }
-        self.last_step = Some(sim.step);
         let mut tris = Vec::new();
         for m in &self.meshes {
             tris.extend(m.read().map_err(|_| lock_err())?.current_triangles(sim.time));
         }
-        let text = crate::io::vtk::format_stl(&tris);
-        let path = self.path.replace('*', &sim.step.to_string());
-        std::fs::write(&path, text).map_err(|e| Error::io(crate::script::Span::DUMMY, format!("dump {}: cannot write '{path}'", self.id), &e))
+        self.frames.write(sim.step, &crate::io::vtk::format_stl(&tris))
     }
     fn id(&self) -> &str {
-        &self.id
+        &self.frames.id
     }
     fn modify(&mut self, args: &[Word]) -> Result<()> {
-        match args.first() {
-            Some(w) => Err(Error::unsupported(w.span, format!("dump_modify {} for dump mesh/stl", w.text))),
-            None => Ok(()),
-        }
+        MeshFrames::modify(args, "mesh/stl")
     }
     fn summary(&self) -> String {
         self.summary.clone()
@@ -980,38 +1023,24 @@ impl Dump for DumpMeshStl {
 }
 
 /// Parse `dump ID group mesh/stl N file [mesh ids...]` (all meshes when no id
-/// is given) into a dump; `s.sim.dumps.push(Box::new(...))` is the caller's.
+/// is given; `stl` is LIGGGHTS's alias) into a dump;
+/// `s.sim.dumps.push(Box::new(...))` is the caller's.
 pub fn dump_mesh_stl(s: &Session, cmd: &Command) -> Result<DumpMeshStl> {
-    let mut a = Args::new(cmd);
-    let id = a.word("dump id")?;
-    let g = a.word("group")?;
-    s.group(g)?;
-    a.choice("dump style", &["mesh/stl", "stl"])?;
-    let every = a.i64("N")?;
-    if every <= 0 {
-        return Err(a.err_prev("dump mesh/stl: N must be > 0"));
-    }
-    let file = a.word("file")?;
+    let (frames, file, mut a) = mesh_dump_head(s, cmd, &["mesh/stl", "stl"])?;
     if !file.text.contains('*') {
         return Err(Error::deck(file.span, "dump mesh/stl: use a file name like 'dump*.stl' (one file per time step, as LIGGGHTS requires)"));
     }
-    let mut meshes = Vec::new();
-    let mut names = Vec::new();
+    let (mut meshes, mut names) = (Vec::new(), Vec::new());
     while a.more() {
         let w = a.word("mesh id")?;
         meshes.push(need_mesh(s, w)?);
         names.push(w.text.clone());
     }
     if meshes.is_empty() {
-        for f in &s.sim.fixes {
-            if let Some(m) = f.as_any().and_then(|x| x.downcast_ref::<MeshSurfaceFix>()) {
-                meshes.push(m.mesh.clone());
-                names.push(m.id.clone());
-            }
-        }
+        (meshes, names) = all_meshes(s);
     }
-    let summary = format!("dump {} mesh/stl every {every} -> {} (meshes {})", id.text, file.text, names.join(" "));
-    Ok(DumpMeshStl { id: id.text.clone(), every, path: file.text.clone(), meshes, last_step: None, summary })
+    let summary = format!("dump {} mesh/stl every {} -> {} (meshes {})", frames.id, frames.every, file.text, names.join(" "));
+    Ok(DumpMeshStl { frames, meshes, summary })
 }
 
 // ------------------------------------------------------------ dump mesh/vtk
@@ -1024,14 +1053,11 @@ const MESH_VTK_PROPS: [&str; 11] = ["stress", "stresscomponents", "id", "vel", "
 /// props... [mesh ids...]` (LIGGGHTS 3.8): the meshes as one legacy VTK
 /// polydata file per frame, with the chosen properties of each triangle.
 pub struct DumpMeshVtk {
-    id: String,
-    every: i64,
-    path: String,
+    frames: MeshFrames,
     output: MeshVtkOutput,
     /// Which of [`MESH_VTK_PROPS`] are written.
     props: [bool; 11],
     meshes: Vec<SharedMesh>,
-    last_step: Option<i64>,
     summary: String,
 }
 
@@ -1125,16 +1151,12 @@ fn merge_arrays(blocks: Vec<Vec<MeshArray>>, per: &[usize]) -> Vec<MeshArray> {
 
 impl Dump for DumpMeshVtk {
     fn due(&self, step: i64, first: bool) -> bool {
-        if self.last_step == Some(step) {
-            return false;
-        }
-        (self.every > 0 && step % self.every == 0) || first
+        self.frames.due(step, first)
     }
     fn write(&mut self, sim: &Sim) -> Result<()> {
         if sim.dry {
             return Ok(());
         }
-        self.last_step = Some(sim.step);
         let (mut tris, mut cells, mut nodes, mut ntri, mut nnode) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for m in &self.meshes {
             let m = m.read().map_err(|_| lock_err())?;
@@ -1146,18 +1168,13 @@ impl Dump for DumpMeshVtk {
             nnode.push(3 * m.tris.len());
         }
         let text = crate::io::vtk::format_mesh_vtk(&tris, merge_arrays(cells, &ntri), merge_arrays(nodes, &nnode), self.output);
-        let path = self.path.replace('*', &sim.step.to_string());
-        crate::io::write_atomic(&path, text.as_bytes())
-            .map_err(|e| Error::runtime(format!("dump {}: cannot write '{path}': {e}", self.id)))
+        self.frames.write(sim.step, &text)
     }
     fn id(&self) -> &str {
-        &self.id
+        &self.frames.id
     }
     fn modify(&mut self, args: &[Word]) -> Result<()> {
-        match args.first() {
-            Some(w) => Err(Error::unsupported(w.span, format!("dump_modify {} for dump mesh/vtk", w.text))),
-            None => Ok(()),
-        }
+        MeshFrames::modify(args, "mesh/vtk")
     }
     fn summary(&self) -> String {
         self.summary.clone()
@@ -1169,16 +1186,7 @@ impl Dump for DumpMeshVtk {
 /// not read, as in LIGGGHTS). A mesh/surface/stress mesh whose stresses
 /// are dumped keeps its pushes per triangle from now on.
 pub fn dump_mesh_vtk(s: &Session, cmd: &Command) -> Result<DumpMeshVtk> {
-    let mut a = Args::new(cmd);
-    let id = a.word("dump id")?;
-    let g = a.word("group")?;
-    s.group(g)?;
-    a.choice("dump style", &["mesh/vtk", "mesh/gran/VTK"])?;
-    let every = a.i64("N")?;
-    if every <= 0 {
-        return Err(a.err_prev("dump mesh/vtk: N must be > 0"));
-    }
-    let file = a.word("file")?;
+    let (frames, file, mut a) = mesh_dump_head(s, cmd, &["mesh/vtk", "mesh/gran/VTK"])?;
     if file.text.ends_with(".vtp") || file.text.ends_with(".pvtp") {
         return Err(Error::unsupported(file.span, "dump mesh/vtk to a .vtp or .pvtp file (XML); demx writes legacy .vtk"));
     }
@@ -1214,14 +1222,9 @@ pub fn dump_mesh_vtk(s: &Session, cmd: &Command) -> Result<DumpMeshVtk> {
         return Err(Error::deck(cmd.span, "dump mesh/vtk: no property to dump").with_hint(format!("name one or more of: {}", MESH_VTK_PROPS.join(" "))));
     }
     if meshes.is_empty() {
-        for f in &s.sim.fixes {
-            if let Some(m) = f.as_any().and_then(|x| x.downcast_ref::<MeshSurfaceFix>()) {
-                meshes.push(m.mesh.clone());
-                names.push(m.id.clone());
-            }
-        }
+        (meshes, names) = all_meshes(s);
     }
-    let d = DumpMeshVtk { id: id.text.clone(), every, path: file.text.clone(), output, props, meshes, last_step: None, summary: String::new() };
+    let d = DumpMeshVtk { frames, output, props, meshes, summary: String::new() };
     if d.wants("stress") || d.wants("stresscomponents") {
         for m in &d.meshes {
             let mut m = m.write().map_err(|_| lock_err())?;
@@ -1232,6 +1235,6 @@ pub fn dump_mesh_vtk(s: &Session, cmd: &Command) -> Result<DumpMeshVtk> {
         }
     }
     let chosen: Vec<&str> = MESH_VTK_PROPS.iter().zip(props).filter(|&(_, on)| on).map(|(&p, _)| p).collect();
-    let summary = format!("dump {} mesh/vtk every {every} -> {} ({}; meshes {})", id.text, file.text, chosen.join(" "), names.join(" "));
+    let summary = format!("dump {} mesh/vtk every {} -> {} ({}; meshes {})", d.frames.id, d.frames.every, file.text, chosen.join(" "), names.join(" "));
     Ok(DumpMeshVtk { summary, ..d })
 }

@@ -551,20 +551,16 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         "atom" | "atom/gz" => (DumpOptions::atom(engine, every.max(0) as u64), vec![]),
         // `stl` and `mesh/gran/VTK` are LIGGGHTS 3.8's own aliases (its
         // DumpStyle lines), kept from 2.x
-        "mesh/stl" | "stl" => {
+        "mesh/stl" | "stl" | "mesh/vtk" | "mesh/gran/VTK" => {
             if s.sim.dumps.iter().any(|x| x.id() == id.text) {
                 return Err(Error::deck(id.span, format!("dump '{}' already exists", id.text)).with_hint("undump it first"));
             }
-            let d = super::mesh::dump_mesh_stl(s, cmd)?;
-            s.sim.dumps.push(Box::new(d));
-            return Ok(());
-        }
-        "mesh/vtk" | "mesh/gran/VTK" => {
-            if s.sim.dumps.iter().any(|x| x.id() == id.text) {
-                return Err(Error::deck(id.span, format!("dump '{}' already exists", id.text)).with_hint("undump it first"));
-            }
-            let d = super::mesh::dump_mesh_vtk(s, cmd)?;
-            s.sim.dumps.push(Box::new(d));
+            let d: Box<dyn crate::engine::output::Dump> = if style.text.ends_with("stl") {
+                Box::new(super::mesh::dump_mesh_stl(s, cmd)?)
+            } else {
+                Box::new(super::mesh::dump_mesh_vtk(s, cmd)?)
+            };
+            s.sim.dumps.push(d);
             return Ok(());
         }
         "local/gran/vtk" | "local" | "image" | "movie" | "xyz" | "cfg" | "vtk" | "decomposition/vtk" | "euler/vtk" => {

@@ -96,3 +96,34 @@ pub fn deck_error(deck: &str) -> String {
     assert_eq!(code, Some(2), "{out}");
     out
 }
+
+/// A square plate of two triangles at height `z` (4 mm a side, at x, y in
+/// [0, 0.004]), as an ASCII STL.
+pub fn plate_stl(z: &str) -> String {
+    format!(
+        "solid plate\nfacet normal 0 0 1\nouter loop\nvertex 0 0 {z}\nvertex 0.004 0 {z}\nvertex 0.004 0.004 {z}\nendloop\nendfacet\n\
+facet normal 0 0 1\nouter loop\nvertex 0 0 {z}\nvertex 0.004 0.004 {z}\nvertex 0 0.004 {z}\nendloop\nendfacet\nendsolid plate\n"
+    )
+}
+
+/// Nine grains thrown at the plate of `plate.stl` (fix `cad`, a
+/// mesh/surface/stress with `cad_args`, walled by Hertz with history), the
+/// middle column faster and sideways, so that the two columns hit at
+/// different times with friction in x and y. `meshes` are fix lines put
+/// before the wall, `tail` everything after the time step.
+pub fn plate_deck(cad_args: &str, meshes: &str, tail: &str) -> String {
+    format!(
+        "units si\natom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\n\
+region box block -0.001 0.005 -0.001 0.005 -0.001 0.004 units box\ncreate_box 1 box\nlattice sc 0.001\n\
+region grains block 0.0005 0.0035 0.0005 0.0035 0.0005 0.0015 units box\ncreate_atoms 1 region grains\n\
+set group all diameter 0.0009 density 2500\n\
+fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\n\
+fix cad all mesh/surface/stress file plate.stl type 1{cad_args}\n{meshes}\
+fix wall all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
+fix g all gravity 9.81 vector 0 0 -1\nregion fast block 0.0015 0.0025 INF INF INF INF units box\n\
+velocity all set 0.1 0 -0.5\ngroup fast region fast\nvelocity fast set 0 0.2 -0.8\nfix 1 all nve/sphere\ntimestep 1e-6\n{tail}"
+    )
+}
