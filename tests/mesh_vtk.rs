@@ -77,12 +77,11 @@ fn mesh_vtk_follows_liggghts() {
 dump c all mesh/vtk 50 c*.vtk output original {props}\ndump d all mesh/vtk 100 d*.vtk top cad vel stress id"
     );
     let (p, t) = (plate("0"), plate("0.0035"));
-    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &deck(&dumps, "dump e all mesh/vtk 50 e*.vtk stress stresscomponents")), ("plate.stl", &p), ("top.stl", &t)]);
-    // After a run break with a grain on the turning plate, demx's first
-    // step's tangential wall force differs from liggghts's by ~2e-6 of
-    // itself (both agree on the setup's forces to 1e-13; found with this
-    // test, not yet explained): the frames of the second run agree to 1e-5.
-    let rel = |step: i64| if step <= 1250 { 1e-8 } else { 1e-5 };
+    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &deck(&dumps, "dump e all mesh/vtk 50 e*.vtk stress stresscomponents vel")), ("plate.stl", &p), ("top.stl", &t)]);
+    // a grain slides on the turning plate across the run break: the
+    // setup's force must leave its history as it was (a reset to the
+    // setup's friction cap made the next step's tangential force 2e-6 off)
+    let rel = |_: i64| 1e-8;
     let (mut frames, mut pushed) = (0, 0);
     for step in (0..=1550).step_by(50) {
         for (mode, every) in [("a", 50), ("b", 50), ("c", 50), ("d", 100)] {

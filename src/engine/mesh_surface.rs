@@ -455,12 +455,18 @@ impl SurfaceMesh {
 
     /// Velocity of each triangle's nodes at `time` (None for a mesh that
     /// neither moves nor has a surface velocity: LIGGGHTS gives such a mesh
-    /// no `v` property).
-    pub fn node_velocities(&self, time: f64) -> Option<Vec<[V3; 3]>> {
+    /// no `v` property). At a run's `setup` a moved mesh shows zeros: the
+    /// engine's move/mesh clears them after the setup's wall forces and
+    /// sets them again at the first step. Zeros are +0, as the engine's
+    /// sums give them.
+    pub fn node_velocities(&self, time: f64, setup: bool) -> Option<Vec<[V3; 3]>> {
         if self.motion.is_none() && self.surface_vel.is_none() {
             return None;
         }
-        Some((0..self.tris.len()).map(|t| self.tris[t].v.map(|p| self.wall_velocity(self.to_world(p, time), t, time))).collect())
+        if setup && self.motion.is_some() {
+            return Some(vec![[V3::zeros(); 3]; self.tris.len()]);
+        }
+        Some((0..self.tris.len()).map(|t| self.tris[t].v.map(|p| self.wall_velocity(self.to_world(p, time), t, time) + V3::zeros())).collect())
     }
 
     /// Triangles at `time` as plain arrays (for `dump mesh/stl`).

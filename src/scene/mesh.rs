@@ -1070,7 +1070,7 @@ impl DumpMeshVtk {
     /// builds them: a property the mesh does not have (stresses of a mesh
     /// without mesh/surface/stress, velocities of a mesh at rest, wear) is
     /// left out.
-    fn arrays(&self, m: &SurfaceMesh, time: f64) -> (Vec<MeshArray>, Vec<MeshArray>) {
+    fn arrays(&self, m: &SurfaceMesh, time: f64, setup: bool) -> (Vec<MeshArray>, Vec<MeshArray>) {
         let n = m.tris.len();
         let (mut cells, mut nodes) = (Vec::new(), Vec::new());
         let arr = |name: &str, ncomp: usize, ty: VtkType, values: Vec<f64>| MeshArray { name: name.to_string(), ncomp, ty, values };
@@ -1095,7 +1095,7 @@ impl DumpMeshVtk {
             cells.push(arr("meshid", 1, VtkType::Int, ints(&|t| t)));
         }
         if self.wants("vel") {
-            if let Some(v) = m.node_velocities(time) {
+            if let Some(v) = m.node_velocities(time, setup) {
                 nodes.push(arr("v", 3, VtkType::Double, v.iter().flatten().flat_map(|p| [p.x, p.y, p.z]).collect()));
             }
         }
@@ -1161,7 +1161,8 @@ impl Dump for DumpMeshVtk {
         for m in &self.meshes {
             let m = m.read().map_err(|_| lock_err())?;
             tris.extend(m.current_triangles(sim.time));
-            let (c, p) = self.arrays(&m, sim.time);
+            // a frame at a run's start is written by its setup
+            let (c, p) = self.arrays(&m, sim.time, sim.step == sim.run_start);
             cells.push(c);
             nodes.push(p);
             ntri.push(m.tris.len());

@@ -4,7 +4,8 @@
 //! xi += v_t dt; xi -= (xi . n) n (projection, no magnitude rescale);
 //! F_el = -k_t xi; if k_t |xi| > mu |F_n|: F_t = F_el mu |F_n| / (k_t |xi|),
 //! xi = -F_t / k_t (computed as xi mu |F_n| / (k_t |xi|)), and no damping while sliding; else
-//! F_t = F_el - gamma_t v_t. Relative velocity and torque use the
+//! F_t = F_el - gamma_t v_t. At a run's setup (dt = 0) xi is used as stored
+//! and kept (the engine's `update_history` is false there). Relative velocity and torque use the
 //! contact-point distance R - delta/2 of each sphere (`surface_model_default.h`).
 
 use super::{add_tangential_torque_lanes, get3_lanes, liggghts_levers_lanes, put3_lanes, rel_tangential_velocity_lanes};
@@ -31,8 +32,14 @@ impl TangentialLaw for LiggghtsHistory {
     fn tangential_lanes<R: Real, P: Coeffs<R>>(&self, c: &ContactL<R>, p: &P, hist: &mut [R], out: &mut OutL<R>) {
         let (cri, crj) = liggghts_levers_lanes(c);
         let vtr = rel_tangential_velocity_lanes(c, cri, crj);
-        let mut xi = get3_lanes(hist) + vtr * R::splat(c.dt);
+        let old = get3_lanes(hist);
+        let mut xi = old + vtr * R::splat(c.dt);
         xi -= c.n * xi.dot(&c.n);
+        // a run's setup (dt = 0) leaves the history as it was: the engine
+        // neither adds to it nor projects it nor resets it to the cap
+        // without `update_history` (a sliding contact across two runs)
+        let setup = R::splat(c.dt).equal(R::splat(0.0));
+        xi = Vec3::select(setup, old, xi);
         let k_t = out.kt;
         let shrmag = xi.norm();
         let ft_el = -xi * k_t;
@@ -50,7 +57,7 @@ impl TangentialLaw for LiggghtsHistory {
         // one multiply by the ratio, not three divisions by k_t (the
         // divider is the batch's scarcest unit; the two differ by rounding)
         xi = Vec3::select(slide.and(moved), xi * ratio, xi);
-        put3_lanes(hist, &xi);
+        put3_lanes(hist, &Vec3::select(setup, old, xi));
         out.ft = ft;
         add_tangential_torque_lanes(c, &ft, cri, crj, out);
     }
