@@ -211,7 +211,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             Ok(())
         }
         "create_atoms" => create_atoms(s, cmd, &mut a),
-        "group" => group_command(s, cmd, &mut a),
+        "group" => group_command(s, cmd, &mut a, vars),
         "set" => set_command(s, cmd, &mut a),
         "velocity" => velocity_command(s, cmd, &mut a, vars),
         "mass" => {
@@ -413,7 +413,7 @@ fn change_box(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     Ok(())
 }
 
-fn group_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+fn group_command(s: &mut Session, cmd: &Command, a: &mut Args, vars: &Variables) -> Result<()> {
     let name = a.word("group name")?;
     let style = a.word("group style")?;
     if style.text == "delete" {
@@ -432,9 +432,23 @@ fn group_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             1u32 << (s.sim.groups.len() - 1)
         }
     };
+    // `variable NAME`: the atoms whose atom-style variable is non-zero now
+    // (LAMMPS `group ID variable`), evaluated before the group's bits change
+    let by_var = if style.text == "variable" {
+        let v = a.word("variable name")?;
+        let vals = vars.eval_atom(&v.text, &s.sim).map_err(|e| Error::deck(v.span, e))?;
+        Some(vals)
+    } else {
+        None
+    };
     let p = &mut s.sim.particles;
     let mut select = vec![false; p.len()];
     match style.text.as_str() {
+        "variable" => {
+            for (sel, v) in select.iter_mut().zip(by_var.unwrap_or_default()) {
+                *sel = v != 0.0;
+            }
+        }
         "type" | "id" | "molecule" => {
             let field: Vec<i64> = if style.text == "type" { p.kind.iter().map(|&k| k as i64).collect() } else { p.tag.clone() };
             let rest = a.rest();
@@ -492,8 +506,8 @@ fn group_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
                 };
             }
         }
-        "dynamic" | "static" | "include" | "variable" => return Err(Error::unsupported(style.span, format!("group {}", style.text))),
-        _ => return Err(bad_keyword(style, "group style", &["type", "id", "region", "empty", "clear", "subtract", "union", "intersect", "delete"])),
+        "dynamic" | "static" | "include" => return Err(Error::unsupported(style.span, format!("group {}", style.text))),
+        _ => return Err(bad_keyword(style, "group style", &["type", "id", "region", "empty", "clear", "subtract", "union", "intersect", "variable", "delete"])),
     }
     let _ = cmd;
     let p = &mut s.sim.particles;
