@@ -317,9 +317,6 @@ fn deck_errors() {
         ("wall/gran granular tangential mindlin NULL 1.0 0.5 zplane -0.01 NULL", 2, "missing the normal model"),
         ("wall/gran granular hertz 1000 0.5 tangential mindlin NULL 1.0 0.5 zplane -0.01 NULL", 2, "kt NULL needs a material normal model"),
         ("wall/gran granular hertz/material 1e7 0.5 0.3 tangential mindlin NULL 1.0 0.5 damping foo zplane -0.01 NULL", 2, "unknown damping model 'foo'"),
-        // the per-atom contact array is not kept: reading it would find nothing
-        ("wall/gran granular hertz 1000 0.5 tangential linear_history 1000 0.5 0.1 zplane -0.01 NULL contacts", 3, "fix wall/gran contacts"),
-        ("wall/gran granular hertz 1000 0.5 tangential linear_history 1000 0.5 0.1 zplane -0.01 NULL bogus", 2, "unknown keyword 'bogus'"),
     ] {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("in.deck"), deck("hooke 1000 0 tangential linear_nohistory 0 0", wall, 10, false)).unwrap();

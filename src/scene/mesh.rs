@@ -897,12 +897,11 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
     a.choice("keyword", &["region"])?;
     let rw = a.word("region id")?;
     let region = super::setup::region(s, rw)?.clone();
-    if a.more() {
+    while a.more() {
         let k = a.word("keyword")?;
-        if k.text == "contacts" {
-            return Err(Error::unsupported(k.span, "fix wall/gran/region contacts (the per-atom array of wall contacts)"));
+        if k.text != "contacts" {
+            return Err(Error::deck(k.span, format!("fix wall/gran/region: unknown keyword '{}'", k.text)));
         }
-        return Err(Error::deck(k.span, format!("fix wall/gran/region: unknown keyword '{}'", k.text)));
     }
     spec.has_coeff = true;
     let table = match granular_table {

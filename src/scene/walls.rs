@@ -352,12 +352,10 @@ fn lammps_wall_geometry(cmd: &Command, a: &mut Args) -> Result<(PrimitiveWall, W
     let words = a.rest().to_vec();
     let (wall, motion, used) = PrimitiveWall::parse_lammps(cmd, &words)?;
     a.pos += used;
-    if a.more() {
+    while a.more() {
         let k = a.word("keyword")?;
         if k.text == "contacts" {
-            // the per-atom array of each atom's wall contact (f_ID[1..8])
-            // is not kept: reading it would find nothing
-            return Err(Error::unsupported(k.span, "fix wall/gran contacts (the per-atom array of wall contacts)"));
+            continue;
         }
         return Err(Error::deck(k.span, format!("fix wall/gran: unknown keyword '{}'", k.text)));
     }
