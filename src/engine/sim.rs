@@ -125,6 +125,9 @@ pub struct Sim {
     pub clock: Instant,
     /// Whether to actually integrate (false for `demx check`).
     pub dry: bool,
+    /// The setup force evaluation of a run is in progress ([`Sim::setup`]):
+    /// walls leave their contact histories where they are.
+    pub setup_pass: bool,
     /// Boltzmann constant of the unit system.
     pub boltz: f64,
     /// Steps per second of the last run.
@@ -181,6 +184,7 @@ impl Default for Sim {
             force_rebuild: true,
             clock: Instant::now(),
             dry: false,
+            setup_pass: false,
             boltz: 1.3806504e-23,
             last_rate: 0.0,
             timing: [0.0; 4],
@@ -445,8 +449,15 @@ impl Sim {
         }
         self.resume = false;
         self.rebuild()?;
+        // the setup force evaluation (LAMMPS/LIGGGHTS `update->setupflag`):
+        // contact histories do not advance. A flag of the pass, not of each
+        // wall: a run resumed from a restart skips this pass, and its first
+        // step must advance the walls' histories as the uninterrupted run's does.
+        self.setup_pass = true;
         self.pair_forces_dt(0.0);
-        self.each_fix(|f, s| f.post_force(s, vars))?;
+        let r = self.each_fix(|f, s| f.post_force(s, vars));
+        self.setup_pass = false;
+        r?;
         self.each_fix(|f, s| f.setup_output(s, vars))?;
         Ok(())
     }

@@ -444,9 +444,6 @@ pub struct WallGranMesh {
     table: ParamTable,
     width: usize,
     summary: String,
-    /// The next post_force is the run setup's: history is not advanced
-    /// (LIGGGHTS/LAMMPS `shearupdate = 0` while `update->setupflag`).
-    in_setup: bool,
 }
 
 impl WallGranMesh {
@@ -467,7 +464,6 @@ impl Fix for WallGranMesh {
         for m in &self.meshes {
             sim.particles.add_extra(&m.hist_name, vec![0.0; self.slot_len()]);
         }
-        self.in_setup = true;
         Ok(())
     }
     /// Between pair-list builds no particle moves more than half the skin
@@ -485,7 +481,7 @@ impl Fix for WallGranMesh {
         let len = self.slot_len();
         let time = sim.time;
         // dt = 0 leaves the history where it is (setup force evaluation)
-        let setup = std::mem::take(&mut self.in_setup);
+        let setup = sim.setup_pass;
         let dt = if setup { 0.0 } else { sim.dt };
         let ns = &sim.neigh;
         let steady = sim.pairs.x_built.len() == sim.particles.len() && ns.check && ns.delay == 0 && ns.every <= 1;
@@ -710,7 +706,7 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
     let width = kernel.history_width();
     let summary = format!("wall/gran {id} (mesh {}): {}", names.join(" "), spec.summary());
     s.walls.push(summary.clone());
-    s.add_fix(Box::new(WallGranMesh { id: id.to_string(), group, meshes, kernel, table, width, summary, in_setup: false }))
+    s.add_fix(Box::new(WallGranMesh { id: id.to_string(), group, meshes, kernel, table, width, summary }))
 }
 
 // ------------------------------------------------------- wall/gran/region
@@ -730,8 +726,6 @@ pub struct WallGranRegion {
     summary: String,
     /// Displacement and angle at the previous step (wall velocity by differences, as LAMMPS).
     prev: Option<(i64, V3, f64)>,
-    /// The next post_force is the run setup's (history not advanced).
-    in_setup: bool,
 }
 
 impl WallGranRegion {
@@ -758,7 +752,6 @@ impl Fix for WallGranRegion {
     }
     fn setup(&mut self, sim: &mut Sim) -> Result<()> {
         sim.particles.add_extra(&self.hist_name, vec![0.0; self.slot_len()]);
-        self.in_setup = true;
         Ok(())
     }
     fn post_force(&mut self, sim: &mut Sim, vars: &Variables) -> Result<()> {
@@ -787,7 +780,7 @@ impl Fix for WallGranRegion {
         let len = self.slot_len();
         let w = 4 + self.width;
         let col = sim.particles.add_extra(&self.hist_name, vec![0.0; len]);
-        let setup = std::mem::take(&mut self.in_setup);
+        let setup = sim.setup_pass;
         let dt = if setup { 0.0 } else { sim.dt };
         let p = &mut sim.particles;
         for i in 0..p.len() {
@@ -922,7 +915,6 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
         hist_name: format!("wall_history:{id}"),
         summary,
         prev: None,
-        in_setup: false,
     }))
 }
 

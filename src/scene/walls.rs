@@ -205,9 +205,6 @@ pub struct WallGran {
     summary: String,
     /// Time the wall motion started.
     t0: f64,
-    /// The next post_force is the setup force evaluation: history does not
-    /// advance (LAMMPS/LIGGGHTS `update->setupflag`).
-    in_setup: bool,
     /// Particles within reach + skin of the wall at pair-list build
     /// `candidates_at`, in increasing index (see `post_force`).
     candidates: Arc<Vec<u32>>,
@@ -229,7 +226,7 @@ impl WallGran {
         let t = sim.time - self.t0;
         let shift = self.motion.shift(self.laws.wall.axis(), t);
         let vwall = self.motion.velocity(t);
-        let dt = if std::mem::take(&mut self.in_setup) { 0.0 } else { sim.dt };
+        let dt = if sim.setup_pass { 0.0 } else { sim.dt };
         WallFrame { shift, vwall, dt }
     }
 
@@ -260,7 +257,6 @@ impl Fix for WallGran {
     }
     fn setup(&mut self, sim: &mut Sim) -> Result<()> {
         sim.particles.add_extra(&self.hist_name, vec![0.0; self.laws.width.max(1)]);
-        self.in_setup = true;
         Ok(())
     }
     fn local(&mut self, hook: Hook, sim: &Sim, _vars: &Variables) -> Result<Local> {
@@ -490,7 +486,6 @@ fn add_wall(s: &mut Session, id: &str, group: u32, spec: PairSpec, table: ParamT
         hist_name: format!("wall_history:{id}"),
         summary,
         t0,
-        in_setup: false,
         candidates: Arc::new(vec![]),
         candidates_at: None,
     }))
