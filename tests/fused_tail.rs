@@ -73,7 +73,7 @@ fn run_with(gravity: &str, after: &str, fused: bool) -> (Vec<u8>, Vec<u8>, u64) 
     let args = DeckArgs { deck: dir.path().join("in.spheres"), var: vec![], perturb: None, var_groups: vec![] };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     let go = || {
-        let (session, _, r) = run_deck(&args, false, 2, None, true, None, Default::default());
+        let (session, _, r) = run_deck(&args, false, 2, None, true, None, Default::default(), None);
         (r, session.sim.pairs.builds)
     };
     let (r, builds) = pool.install(|| if fused { go() } else { with_unfused_tail(go) });

@@ -79,7 +79,7 @@ fn run(model: &str, pruned: bool, scalar: bool) -> (Vec<u8>, u64, u64) {
     let args = DeckArgs { deck: dir.path().join("in.bed"), var: vec![], perturb: None, var_groups: vec![] };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     let go = || {
-        let (session, _, r) = run_deck(&args, false, 2, None, true, None, Default::default());
+        let (session, _, r) = run_deck(&args, false, 2, None, true, None, Default::default(), None);
         (r, session.sim.pairs.builds, session.sim.pairs.prunes)
     };
     let go = || if scalar { with_scalar_pass(go) } else { go() };

@@ -39,7 +39,9 @@ fn full_and_resumed(files: &[(&str, &str)], head: &str, resume_head: &str, tail:
     for (name, text) in files {
         std::fs::write(d.join(name), text).unwrap();
     }
-    let dump = |name: &str| format!("dump d all custom {EVERY} dump.{name} id x y z vx vy vz fx fy fz omegax omegay omegaz\ndump_modify d format float %20.15g\n");
+    let dump = |name: &str| {
+        format!("dump d all custom {EVERY} dump.{name} id x y z vx vy vz fx fy fz omegax omegay omegaz\ndump_modify d format float %20.15g\n")
+    };
     std::fs::write(d.join("in.full"), format!("{head}{tail}{}restart {R} restart.*\nrun {END}\n", dump("full"))).unwrap();
     std::fs::write(d.join("in.resumed"), format!("{resume_head}read_restart restart.{R}\n{tail}{}run {END} upto\n", dump("resumed"))).unwrap();
     demx(d, "in.full");

@@ -114,7 +114,7 @@ fn run_in_process(model: &str, scalar: bool) -> Vec<u8> {
     std::fs::write(dir.path().join("in.spheres"), deck("neighbor 0.0005 bin\nneigh_modify delay 0", model, &d)).unwrap();
     let args = DeckArgs { deck: dir.path().join("in.spheres"), var: vec![], perturb: None, var_groups: vec![] };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-    let go = || run_deck(&args, false, 2, None, true, None, Default::default()).2;
+    let go = || run_deck(&args, false, 2, None, true, None, Default::default(), None).2;
     let r = pool.install(|| if scalar { with_scalar_pass(go) } else { go() });
     assert!(r.is_ok(), "demx failed: {:?}", r.err());
     std::fs::read(dir.path().join("dump.spheres")).expect("dump written")

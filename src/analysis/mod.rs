@@ -9,4 +9,5 @@ pub mod repose;
 pub mod packing;
 pub mod saltation;
 pub mod sweep;
+pub mod campaign;
 pub mod tradeoff;

@@ -63,6 +63,19 @@ enum Cmd {
         /// walls) by S: softer particles allow longer time steps.
         #[arg(long, value_name = "S")]
         youngs_scale: Option<f64>,
+        /// Keep a checkpoint of the whole run in DIR (before a `run` line of
+        /// the deck, every --checkpoint-every seconds, and when SIGTERM or a
+        /// file DIR/STOP asks the run to stop, which then exits with code
+        /// 75). The same command continues from DIR's checkpoint, bit for
+        /// bit as if the run had not stopped; a finished run removes it.
+        #[arg(long, value_name = "DIR")]
+        checkpoint: Option<std::path::PathBuf>,
+        /// Seconds of wall time between checkpoints.
+        #[arg(long, value_name = "S", default_value_t = 600.0)]
+        checkpoint_every: f64,
+        /// Stop after this many checkpoints (tests).
+        #[arg(long, hide = true)]
+        checkpoint_stop_after: Option<u32>,
     },
     /// Read and validate a deck without running it; print a summary.
     Check {
@@ -106,6 +119,9 @@ enum Cmd {
     /// Angle of repose over particle size and gravity: runs and the paper's fits.
     #[command(disable_help_flag = true)]
     Sweep(Passthrough),
+    /// A declared matrix of runs that survives stops and moves with the repository.
+    #[command(disable_help_flag = true)]
+    Campaign(Passthrough),
 }
 
 /// Arguments handed unparsed to a subcommand's own parser.
@@ -186,6 +202,7 @@ pub fn run_deck(
     quiet: bool,
     max_steps: Option<i64>,
     overrides: crate::scene::overrides::Overrides,
+    checkpoints: Option<crate::scene::checkpoint::Checkpoints>,
 ) -> (Session, SourceMap, Result<()>) {
     let sources = SourceMap::new();
     let mut session = Session::new(check);
@@ -200,14 +217,22 @@ pub fn run_deck(
     if check || quiet {
         session.sim.log.screen = false;
     }
+    session.checkpoints = checkpoints;
+    let resume = match session.checkpoints.as_mut().map(|c| c.load()).transpose() {
+        Ok(r) => r.flatten(),
+        Err(e) => return (session, sources, Err(e)),
+    };
     if let Some(l) = log.filter(|l| *l != "none") {
-        if let Err(e) = session.sim.log.open(l, false) {
+        // a resumed run goes on writing the log it had
+        if let Err(e) = session.sim.log.open(l, resume.is_some()) {
             return (session, sources, Err(Error::io(crate::script::Span::DUMMY, format!("cannot open log file '{l}'"), &e)));
         }
     }
     let mut interp = Interpreter::new(sources.clone(), cli_vars(deck));
     if check {
         interp.set_command_limit(2_000_000);
+        // a check writes nothing, anywhere
+        interp.set_file_writes(false);
     }
     if let Some(text) = text.filter(|t| crate::convert::is_legacy_liggghts(t)) {
         match legacy_in_memory(&sources, &deck.deck, &text) {
@@ -223,7 +248,13 @@ pub fn run_deck(
             Err(e) => return (session, sources, Err(e)),
         }
     }
-    let r = interp.run_file(&deck.deck, &mut session);
+    let r = match resume {
+        Some(resume) => match crate::scene::checkpoint::resume(&mut session, resume) {
+            Ok(saved) => interp.resume(&saved, &deck.deck, &mut session),
+            Err(e) => Err(e),
+        },
+        None => interp.run_file(&deck.deck, &mut session),
+    };
     (session, sources, r)
 }
 
@@ -272,7 +303,7 @@ pub fn main() -> ExitCode {
         }
     };
     match cli.cmd {
-        Cmd::Run { mut deck, threads, log, quiet, max_steps, dt_fraction, youngs_scale } => {
+        Cmd::Run { mut deck, threads, log, quiet, max_steps, dt_fraction, youngs_scale, checkpoint, checkpoint_every, checkpoint_stop_after } => {
             deck.var_groups = groups.clone();
             let overrides = match crate::scene::overrides::Overrides::new(dt_fraction, youngs_scale) {
                 Ok(o) => o,
@@ -288,9 +319,34 @@ pub fn main() -> ExitCode {
                     return ExitCode::from(1);
                 }
             };
-            let (_s, sources, r) = pool.install(|| run_deck(&deck, false, threads, Some(&log), quiet, max_steps, overrides));
+            let checkpoints = match checkpoint {
+                Some(dir) if checkpoint_every.is_finite() && checkpoint_every >= 0.0 => {
+                    let mut c = crate::scene::checkpoint::Checkpoints::new(dir, std::time::Duration::from_secs_f64(checkpoint_every));
+                    c.stop_after = checkpoint_stop_after;
+                    Some(c)
+                }
+                Some(_) => {
+                    eprintln!("error: --checkpoint-every must be a number of seconds >= 0");
+                    return ExitCode::from(2);
+                }
+                None => None,
+            };
+            let (s, sources, r) = pool.install(|| run_deck(&deck, false, threads, Some(&log), quiet, max_steps, overrides, checkpoints));
             match r {
-                Ok(()) => ExitCode::SUCCESS,
+                Ok(()) if s.checkpoints.as_ref().is_some_and(|c| c.stopped) => {
+                    eprintln!("demx: stopped at a checkpoint; run the same command again to continue");
+                    ExitCode::from(crate::scene::checkpoint::STOPPED)
+                }
+                Ok(()) => {
+                    // finished: the checkpoint has nothing left to resume
+                    if let Some(c) = &s.checkpoints {
+                        if let Err(e) = c.finish(s.sim.step, threads) {
+                            eprintln!("error: checkpoint folder {}: {e}", c.dir.display());
+                            return ExitCode::from(1);
+                        }
+                    }
+                    ExitCode::SUCCESS
+                }
                 Err(e) => report(&e, &sources),
             }
         }
@@ -314,7 +370,7 @@ pub fn main() -> ExitCode {
         }
         Cmd::Check { mut deck, json, .. } => {
             deck.var_groups = groups.clone();
-            let (s, sources, r) = run_deck(&deck, true, 1, None, true, None, Default::default());
+            let (s, sources, r) = run_deck(&deck, true, 1, None, true, None, Default::default(), None);
             match r {
                 Ok(()) => {
                     let sum = Summary::of(&s);
@@ -343,6 +399,7 @@ pub fn main() -> ExitCode {
         Cmd::Saltation(p) => crate::analysis::saltation::cli(p.args),
         Cmd::Tradeoff(p) => crate::analysis::tradeoff::cli(p.args),
         Cmd::Sweep(p) => crate::analysis::sweep::cli(p.args),
+        Cmd::Campaign(p) => crate::analysis::campaign::cli(p.args),
     }
 }
 

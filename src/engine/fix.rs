@@ -209,6 +209,39 @@ pub trait Fix: Send {
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         None
     }
+    /// What a checkpoint must keep of this fix beyond what its command sets
+    /// up again (`demx run --checkpoint`). The default says a checkpoint
+    /// cannot be taken while the fix exists, so that a fix added later
+    /// without this never resumes wrong.
+    fn save_state(&self) -> FixState {
+        FixState::Unsupported
+    }
+    /// Put back what [`Fix::save_state`] kept.
+    fn load_state(&mut self, _state: &serde_json::Value) -> std::result::Result<(), String> {
+        Ok(())
+    }
+}
+
+/// A fix's part of a checkpoint ([`Fix::save_state`]).
+pub enum FixState {
+    /// Everything it holds is set by its command or lives in the particles
+    /// and the pair list, or is a cache that gives the same bits when
+    /// rebuilt.
+    Stateless,
+    /// Its changing state.
+    Saved(serde_json::Value),
+    /// It holds state a checkpoint cannot keep yet.
+    Unsupported,
+}
+
+/// [`Fix::save_state`] for a fix whose command sets everything it holds.
+#[macro_export]
+macro_rules! stateless_fix {
+    () => {
+        fn save_state(&self) -> $crate::engine::fix::FixState {
+            $crate::engine::fix::FixState::Stateless
+        }
+    };
 }
 
 /// The deepest surface overlap among the particles of `group`, as

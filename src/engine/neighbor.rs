@@ -1047,13 +1047,29 @@ impl PairList {
     /// The list with every pair of the last build and its history, as if it
     /// had not been pruned (for a restart file).
     pub fn full(&self, n: usize) -> PairList {
+        let mut l = self.unpruned();
+        if self.outer.is_some() {
+            l.index(n);
+        }
+        l
+    }
+
+    /// [`PairList::full`] without the derived indexes: for a list that no
+    /// longer fits the particles (deleted or inserted since its build), whose
+    /// ids and histories the next build carries over.
+    pub fn unpruned(&self) -> PairList {
         let mut l = self.clone();
         if l.outer.is_some() {
             l.refilter(|_, _, _| true);
             l.x_pruned.clear();
-            l.index(n);
         }
         l
+    }
+
+    /// Whether the list was built for the particles as they are (no
+    /// particle inserted, deleted or reordered since its build).
+    pub fn fits(&self, n: usize) -> bool {
+        self.x_built.len() == n && self.a.iter().chain(&self.b).all(|&k| (k as usize) < n)
     }
 
     /// Where the next build finds the history of pairs listed now: by storage

@@ -419,6 +419,30 @@ pub trait Dump: Send {
     }
     /// One line for `demx check`.
     fn summary(&self) -> String;
+    /// How this dump's file goes on across a checkpoint (`demx run
+    /// --checkpoint`). The default says it cannot.
+    fn checkpoint_file(&self) -> DumpFile {
+        DumpFile::Unsupported
+    }
+    /// The step of the last frame written (a frame is written once per step).
+    fn last_step(&self) -> Option<i64> {
+        None
+    }
+    /// Resuming from a checkpoint: the step of the last frame written then,
+    /// and whether the file goes on (cut back to its length at the
+    /// checkpoint and appended to) instead of starting anew.
+    fn resume_at(&mut self, _last_step: Option<i64>, _append: bool) {}
+}
+
+/// A dump's file at a checkpoint ([`Dump::checkpoint_file`]).
+pub enum DumpFile {
+    /// Not opened yet, or one file per frame: the resumed run writes as
+    /// the uninterrupted one would.
+    Fresh,
+    /// One file, open: cut back to its length at the checkpoint, then appended to.
+    Appended(std::path::PathBuf),
+    /// A checkpoint cannot carry it on yet.
+    Unsupported,
 }
 
 /// Placeholder while a dump writes.

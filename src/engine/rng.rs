@@ -2,7 +2,7 @@
 //! (`RanPark`), so seeded insertions are reproducible and platform-independent.
 
 /// Park-Miller generator (a = 16807, m = 2^31 - 1, Schrage's method).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Park {
     seed: i64,
     /// The second value of the last Gaussian pair, not yet returned.

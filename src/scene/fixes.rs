@@ -21,6 +21,7 @@ pub struct Noop {
 }
 
 impl Fix for Noop {
+    crate::stateless_fix!();
     crate::no_step_hooks!();
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
@@ -42,6 +43,7 @@ pub struct NveSphere {
 }
 
 impl Fix for NveSphere {
+    crate::stateless_fix!();
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
     }
@@ -78,6 +80,7 @@ pub struct Nve {
 }
 
 impl Fix for Nve {
+    crate::stateless_fix!();
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
     }
@@ -146,6 +149,7 @@ impl Magnitude {
 }
 
 impl Fix for Gravity {
+    crate::stateless_fix!();
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
     }
@@ -288,6 +292,7 @@ impl Stage for Hold {
 }
 
 impl Fix for Freeze {
+    crate::stateless_fix!();
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
     }
@@ -380,6 +385,7 @@ pub struct AddForce {
 }
 
 impl Fix for AddForce {
+    crate::stateless_fix!();
     crate::post_force_only!();
     fn id(&self) -> &str {
         &self.id
@@ -429,6 +435,7 @@ pub struct Viscous {
 }
 
 impl Fix for Viscous {
+    crate::stateless_fix!();
     crate::post_force_only!();
     fn id(&self) -> &str {
         &self.id
@@ -463,6 +470,14 @@ pub struct Print {
 }
 
 impl Fix for Print {
+    fn save_state(&self) -> crate::engine::fix::FixState {
+        // a file it writes would be opened anew (and cut) by the resumed run
+        if self.file.is_some() {
+            crate::engine::fix::FixState::Unsupported
+        } else {
+            crate::engine::fix::FixState::Stateless
+        }
+    }
     crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id
@@ -586,6 +601,10 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
                 match k.text.as_str() {
                     "file" | "append" => {
                         let w = a.word("file name")?;
+                        // `demx check` (and a checkpoint's replay) writes nothing
+                        if sim.dry {
+                            continue;
+                        }
                         let f = if k.text == "file" {
                             std::fs::File::create(&w.text)
                         } else {
@@ -806,6 +825,7 @@ impl CheckTimestep {
 }
 
 impl Fix for CheckTimestep {
+    crate::stateless_fix!();
     crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id

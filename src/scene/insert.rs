@@ -277,6 +277,7 @@ impl Template {
 }
 
 impl Fix for Template {
+    crate::stateless_fix!();
     crate::no_step_hooks!();
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
@@ -449,6 +450,19 @@ impl Distribution {
 }
 
 impl Fix for Distribution {
+    fn save_state(&self) -> crate::engine::fix::FixState {
+        // the generator the insertions draw templates from (shared with
+        // every insertion fix that uses this distribution)
+        match self.rng.lock() {
+            Ok(g) => serde_json::to_value(&*g).map_or(crate::engine::fix::FixState::Unsupported, crate::engine::fix::FixState::Saved),
+            Err(_) => crate::engine::fix::FixState::Unsupported,
+        }
+    }
+    fn load_state(&mut self, state: &serde_json::Value) -> std::result::Result<(), String> {
+        let park: crate::engine::rng::Park = serde_json::from_value(state.clone()).map_err(|e| e.to_string())?;
+        *self.rng.lock().map_err(|_| "distribution generator poisoned".to_string())? = park;
+        Ok(())
+    }
     crate::no_step_hooks!();
     fn end_of_step_due(&self, _step: i64) -> bool {
         false
@@ -622,6 +636,18 @@ pub struct LiggghtsInsert {
     /// insert/stream: the insertion face and the particles not yet released.
     pub stream: Option<Box<StreamFace>>,
     span: Span,
+}
+
+/// What a checkpoint keeps of a LIGGGHTS insertion fix.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct InsertState {
+    rng: Park,
+    gauss_save: Option<f64>,
+    region_rng: Park,
+    next: Option<i64>,
+    ninserted: i64,
+    mass_inserted: f64,
+    region_volume: Option<f64>,
 }
 
 /// Where an insert/stream particle started and when it is released.
@@ -1416,6 +1442,33 @@ impl LiggghtsInsert {
 }
 
 impl Fix for LiggghtsInsert {
+    fn save_state(&self) -> crate::engine::fix::FixState {
+        // insert/stream keeps its particles in flight: not yet
+        if self.stream.is_some() {
+            return crate::engine::fix::FixState::Unsupported;
+        }
+        let st = InsertState {
+            rng: self.rng.clone(),
+            gauss_save: self.gauss_save,
+            region_rng: self.region_rng.clone(),
+            next: self.next,
+            ninserted: self.ninserted,
+            mass_inserted: self.mass_inserted,
+            region_volume: self.region_volume,
+        };
+        serde_json::to_value(st).map_or(crate::engine::fix::FixState::Unsupported, crate::engine::fix::FixState::Saved)
+    }
+    fn load_state(&mut self, state: &serde_json::Value) -> std::result::Result<(), String> {
+        let st: InsertState = serde_json::from_value(state.clone()).map_err(|e| e.to_string())?;
+        self.rng = st.rng;
+        self.gauss_save = st.gauss_save;
+        self.region_rng = st.region_rng;
+        self.next = st.next;
+        self.ninserted = st.ninserted;
+        self.mass_inserted = st.mass_inserted;
+        self.region_volume = st.region_volume;
+        Ok(())
+    }
     crate::no_step_hooks!();
     fn id(&self) -> &str {
         &self.id

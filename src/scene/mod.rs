@@ -18,6 +18,7 @@ pub mod wind;
 pub mod heat;
 pub mod overrides;
 pub mod velocity;
+pub mod checkpoint;
 
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{did_you_mean, Error, Result};
@@ -102,6 +103,13 @@ pub struct Session {
     pub replay: Vec<String>,
     /// Command-line accuracy overrides (`demx run --dt-fraction/--youngs-scale`).
     pub overrides: overrides::Overrides,
+    /// `demx run --checkpoint`: where and how often.
+    pub checkpoints: Option<checkpoint::Checkpoints>,
+    /// Every command executed so far (words and whether quoted), for a
+    /// checkpoint's replay.
+    pub journal: Vec<Vec<(String, bool)>>,
+    /// A checkpoint's journal is being replayed.
+    pub replaying: bool,
 }
 
 /// Commands that only tune MPI, communication or memory: accepted, recorded,
@@ -186,6 +194,9 @@ impl Session {
             sources: vec![],
             replay: vec![],
             overrides: overrides::Overrides::default(),
+            checkpoints: None,
+            journal: vec![],
+            replaying: false,
         }
     }
 
@@ -601,7 +612,16 @@ impl Host for Session {
         if replayed(cmd) {
             self.replay.push(cmd.text());
         }
+        if self.checkpoints.is_some() && !self.replaying {
+            self.journal.push(cmd.words.iter().map(|w| (w.text.clone(), w.quoted)).collect());
+        }
         Ok(())
+    }
+    fn checkpoint_due(&mut self) -> bool {
+        !self.check && self.checkpoints.as_ref().is_some_and(|c| c.due(self.journal.len()))
+    }
+    fn checkpoint(&mut self, saved: &crate::script::interp::SavedInterpreter) -> Result<bool> {
+        checkpoint::write(self, saved)
     }
     fn output(&mut self, text: &str) {
         self.sim.log.line(text);

@@ -277,6 +277,24 @@ impl Dump for DumpText {
     fn summary(&self) -> String {
         self.summary.clone()
     }
+    fn checkpoint_file(&self) -> crate::engine::output::DumpFile {
+        use crate::engine::output::DumpFile;
+        if self.path.contains('*') || self.writer.is_none() {
+            DumpFile::Fresh
+        } else if self.path.ends_with(".gz") {
+            // a gzip stream cannot be cut back at a frame and appended to
+            DumpFile::Unsupported
+        } else {
+            DumpFile::Appended(self.path.clone().into())
+        }
+    }
+    fn last_step(&self) -> Option<i64> {
+        self.last_step
+    }
+    fn resume_at(&mut self, last_step: Option<i64>, append: bool) {
+        self.last_step = last_step;
+        self.opts.append |= append;
+    }
 }
 
 /// The frame of group `group` with the given columns at the current step.

@@ -83,6 +83,10 @@ pub struct RestartState {
     virial: f64,
     #[serde(default)]
     virial_tensor: Option<[f64; 6]>,
+    /// The pair list no longer fits the particles (built before some were
+    /// inserted or deleted): the next run rebuilds it.
+    #[serde(default)]
+    stale: bool,
     /// Commands (as text) that defined units, materials and the contact model.
     pub replay: Vec<String>,
 }
@@ -98,8 +102,12 @@ impl RestartState {
         let p = &sim.particles;
         // the list as if it had not been pruned: the resumed run need not
         // know the prune
-        let pairs = sim.pairs.full(p.len());
-        let (adj_start, adj) = pairs.adjacency(p.len());
+        // a list built before particles were inserted or deleted (between
+        // runs) is kept as it is, for the next build to carry its histories
+        // over by ids, as the uninterrupted run's next build does
+        let stale = sim.force_rebuild || !sim.pairs.fits(p.len());
+        let pairs = if stale { sim.pairs.unpruned() } else { sim.pairs.full(p.len()) };
+        let (adj_start, adj) = if stale { (vec![0; p.len() + 1], vec![]) } else { pairs.adjacency(p.len()) };
         let sides: String = d.sides.iter().flat_map(|s| [s[0].letter(), s[1].letter()]).collect();
         Ok(RestartState {
             format: FORMAT.into(),
@@ -142,8 +150,14 @@ impl RestartState {
             builds: pairs.builds,
             virial: sim.pair_virial.trace,
             virial_tensor: sim.virial_tensor(),
+            stale,
             replay,
         })
+    }
+
+    /// The step it was taken at.
+    pub fn step(&self) -> i64 {
+        self.step
     }
 
     /// Write atomically (temporary file + rename).
@@ -236,10 +250,10 @@ impl RestartState {
             && self.pair_shift.len() == m
             && self.pair_hist.len() == m * self.pair_width
             && self.adj_start.len() == n + 1
-            && self.x_built.len() == n
+            && (self.stale || self.x_built.len() == n)
             && self.f.len() == n
             && self.torque.len() == n
-            && self.pair_a.iter().chain(&self.pair_b).all(|&k| (k as usize) < n.max(1));
+            && (self.stale || self.pair_a.iter().chain(&self.pair_b).all(|&k| (k as usize) < n.max(1)));
         if !consistent {
             return Err("restart file is inconsistent (pair list)".into());
         }
@@ -261,12 +275,15 @@ impl RestartState {
             ..Default::default()
         };
         sim.pairs.set_shifts(&self.pair_shift.iter().map(a3).collect::<Vec<_>>());
-        sim.pairs.index(n);
+        if !self.stale {
+            sim.pairs.index(n);
+        }
         sim.pair_virial = crate::engine::kernel::Virial { trace: self.virial, tensor: self.virial_tensor.unwrap_or_default() };
         sim.tensor_at = self.virial_tensor.map(|_| self.step);
         // continue exactly: the next run reuses the saved list and forces
-        sim.force_rebuild = false;
-        sim.resume = true;
+        // (a stale list is rebuilt first, as the uninterrupted run does)
+        sim.force_rebuild = self.stale;
+        sim.resume = !self.stale;
         Ok(())
     }
 }
@@ -280,6 +297,13 @@ pub struct RestartWriter {
 }
 
 impl Fix for RestartWriter {
+    fn save_state(&self) -> crate::engine::fix::FixState {
+        crate::engine::fix::FixState::Saved(serde_json::json!(self.toggle))
+    }
+    fn load_state(&mut self, state: &serde_json::Value) -> std::result::Result<(), String> {
+        self.toggle = state.as_u64().ok_or("restart toggle")? as usize;
+        Ok(())
+    }
     crate::no_step_hooks!();
     fn id(&self) -> &str {
         "__restart"
@@ -316,7 +340,8 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
         "write_restart" => {
             s.need_box(cmd)?;
             let w = a.word("file")?;
-            if s.check {
+            // `demx check` and a checkpoint's replay write nothing
+            if s.check || s.sim.dry {
                 return Ok(());
             }
             let name = w.text.replace('*', &s.sim.step.to_string());
@@ -369,7 +394,8 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
         "write_data" => {
             s.need_box(cmd)?;
             let w = a.word("file")?;
-            if s.check {
+            // `demx check` and a checkpoint's replay write nothing
+            if s.check || s.sim.dry {
                 return Ok(());
             }
             let d = s.sim.domain.as_ref().ok_or_else(|| Error::runtime("no box"))?;

@@ -37,8 +37,31 @@ pub enum Echo {
 /// One open input file.
 #[derive(Clone, Debug)]
 struct Frame {
+    file: FileId,
     lines: Arc<Vec<LogicalLine>>,
     pos: usize,
+}
+
+/// Where a deck stands between two commands, as a checkpoint keeps it
+/// ([`Interpreter::save_before_current`], [`Interpreter::resume`]): the
+/// variables, and each open file (the deck first, then nested includes) with
+/// the index of the logical line to run next.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct SavedInterpreter {
+    /// The variable store.
+    pub vars: super::vars::SavedVariables,
+    /// Open files, outermost first: path, next logical line, and the FNV-1a
+    /// hash of the file's text (a changed file cannot be resumed).
+    pub frames: Vec<(PathBuf, usize, u64)>,
+    /// A `next` ran out of values and the next `jump` is to be skipped.
+    pub jump_skip: bool,
+    /// Lines and commands processed so far (for the command limit).
+    pub count: u64,
+}
+
+/// FNV-1a (64 bits) of a text: the same on every machine and build.
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
 }
 
 /// Most input files open at once (nested `include`).
@@ -61,6 +84,11 @@ pub struct Interpreter {
     limit: Option<u64>,
     count: u64,
     file_access: bool,
+    /// Whether `print ... file/append` writes (off for `demx check`).
+    write_files: bool,
+    /// Commands run from inside another (`if`, `run every`): a checkpoint is
+    /// taken only at a deck's own `run` lines.
+    nested: u32,
 }
 
 impl Interpreter {
@@ -83,6 +111,8 @@ impl Interpreter {
             limit: None,
             count: 0,
             file_access: true,
+            write_files: true,
+            nested: 0,
         }
     }
 
@@ -102,6 +132,12 @@ impl Interpreter {
     /// file, reads fail with an error).
     pub fn set_file_access(&mut self, allow: bool) {
         self.file_access = allow;
+    }
+
+    /// Whether `print ... file/append` writes its file (`demx check` writes
+    /// nothing; reads stay allowed).
+    pub fn set_file_writes(&mut self, allow: bool) {
+        self.write_files = allow;
     }
 
     /// Number of lines and commands processed so far.
@@ -140,9 +176,54 @@ impl Interpreter {
         self.jump_skip = false;
         let base = self.stack.len();
         let lines = self.lines_of(id);
-        self.stack.push(Frame { lines, pos: 0 });
+        self.stack.push(Frame { file: id, lines, pos: 0 });
         let r = self.drive(base, host);
         self.stack.truncate(base);
+        r
+    }
+
+    /// The state before the command now running, a top-level `run` line
+    /// ([`Host::checkpoint_due`]): resuming runs that line again.
+    fn save_before_current(&self) -> SavedInterpreter {
+        let frames = self
+            .stack
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let (path, hash) = self.sources.get(f.file).map(|s| (s.path.clone(), fnv1a(&s.text))).unwrap_or_default();
+                // the innermost file's line was already taken
+                let pos = if k + 1 == self.stack.len() { f.pos.saturating_sub(1) } else { f.pos };
+                (path, pos, hash)
+            })
+            .collect();
+        SavedInterpreter { vars: self.vars.save(), frames, jump_skip: self.jump_skip, count: self.count.saturating_sub(1) }
+    }
+
+    /// Continue a deck from a checkpoint's state: `deck` stands for the
+    /// outermost file (the deck may have moved since), the other files are
+    /// read from their saved paths.
+    pub fn resume(&mut self, saved: &SavedInterpreter, deck: &Path, host: &mut dyn Host) -> Result<()> {
+        self.vars = super::Variables::restore(&saved.vars).map_err(|m| Error::runtime(format!("checkpoint: {m}")))?;
+        self.quit = false;
+        self.label = None;
+        self.jump_skip = saved.jump_skip;
+        self.count = saved.count;
+        self.stack.clear();
+        for (k, (path, pos, hash)) in saved.frames.iter().enumerate() {
+            let file = if k == 0 { deck } else { path };
+            let id = self.load(file, Span::DUMMY)?;
+            let lines = self.lines_of(id);
+            let now = self.sources.get(id).map(|s| fnv1a(&s.text)).unwrap_or_default();
+            if now != *hash || *pos > lines.len() {
+                return Err(Error::runtime(format!(
+                    "checkpoint: {} has changed since the checkpoint was written; it resumes only the file it was taken in",
+                    file.display()
+                )));
+            }
+            self.stack.push(Frame { file: id, lines, pos: *pos });
+        }
+        let r = self.drive(0, host);
+        self.stack.clear();
         r
     }
 
@@ -256,7 +337,7 @@ impl Interpreter {
                 }
                 let id = self.load(Path::new(&args[0].text), args[0].span)?;
                 let lines = self.lines_of(id);
-                self.stack.push(Frame { lines, pos: 0 });
+                self.stack.push(Frame { file: id, lines, pos: 0 });
                 Ok(())
             }
             "if" => self.ifthenelse(&words, name_span, host),
@@ -287,7 +368,23 @@ impl Interpreter {
                 self.quit = true;
                 Ok(())
             }
-            "run" if args.iter().any(|w| w.text == "every") => self.run_every(&cmd, &words, host),
+            "run" if args.iter().any(|w| w.text == "every") => {
+                self.nested += 1;
+                let r = self.run_every(&cmd, &words, host);
+                self.nested -= 1;
+                r
+            }
+            "run" if self.nested == 0 && host.checkpoint_due() => {
+                // a deck's own `run` line: the state before it is complete
+                // (no command half done), so a checkpoint taken here resumes
+                // by running this line again
+                let saved = self.save_before_current();
+                if host.checkpoint(&saved)? {
+                    self.quit = true;
+                    return Ok(());
+                }
+                host.execute(&cmd, &mut self.vars)
+            }
             _ => host.execute(&cmd, &mut self.vars),
         }
     }
@@ -309,7 +406,7 @@ impl Interpreter {
         } else {
             let id = self.load(Path::new(&args[0].text), args[0].span)?;
             let lines = self.lines_of(id);
-            self.stack[top] = Frame { lines, pos: 0 };
+            self.stack[top] = Frame { file: id, lines, pos: 0 };
         }
         if let Some(l) = args.get(1) {
             self.label = Some((l.text.clone(), l.span));
@@ -357,7 +454,10 @@ impl Interpreter {
                     if c.s.trim().is_empty() {
                         return Err(illegal(args[first + k].text.span(), "empty command"));
                     }
-                    self.process(c, host)?;
+                    self.nested += 1;
+                    let r = self.process(c, host);
+                    self.nested -= 1;
+                    r?;
                     if self.quit {
                         break;
                     }
@@ -410,7 +510,7 @@ impl Interpreter {
             k += 2;
         }
         if let Some((f, append)) = file {
-            if self.file_access {
+            if self.file_access && self.write_files {
                 use std::io::Write;
                 let mut opts = std::fs::OpenOptions::new();
                 if append {

@@ -135,4 +135,14 @@ pub trait Host: EvalContext {
     /// The `log` command: switch the log file (`append` for `log file append`),
     /// `None` for `log none`.
     fn set_log(&mut self, path: Option<&str>, append: bool, span: Span) -> Result<()>;
+    /// Whether to write a checkpoint before the deck's `run` line about to
+    /// execute (`demx run --checkpoint`).
+    fn checkpoint_due(&mut self) -> bool {
+        false
+    }
+    /// Write a checkpoint: the host's state with the interpreter's `saved`.
+    /// Returns true when the run is to stop there (a stop was asked for).
+    fn checkpoint(&mut self, _saved: &interp::SavedInterpreter) -> Result<bool> {
+        Ok(false)
+    }
 }

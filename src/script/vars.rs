@@ -21,7 +21,7 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 /// Style of a variable.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum VarStyle {
     /// `index v1 v2 ...`
     Index,
@@ -79,6 +79,27 @@ enum Data {
     Format { var: String, fmt: String },
     Formula { text: String, expr: Arc<Expr> },
     Internal(f64),
+}
+
+/// A variable's definition and position, as a checkpoint keeps it (a
+/// formula by its text, compiled again when restored).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+enum SavedData {
+    List { values: Vec<String>, which: usize },
+    Loop { first: i64, last: i64, which: i64, pad: usize },
+    Str(String),
+    Getenv(String),
+    Format { var: String, fmt: String },
+    Formula(String),
+    Internal(f64),
+}
+
+/// The whole variable store as a checkpoint keeps it: every variable with
+/// its position in its list, and the state of `random()`/`normal()`.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct SavedVariables {
+    vars: Vec<(String, VarStyle, SavedData)>,
+    rng: Option<u64>,
 }
 
 #[derive(Clone, Debug)]
@@ -161,6 +182,51 @@ impl Variables {
     /// An empty store.
     pub fn new() -> Variables {
         Variables::default()
+    }
+
+    /// Everything the store holds, for a checkpoint (sorted by name, so the
+    /// same store gives the same text).
+    pub fn save(&self) -> SavedVariables {
+        let mut vars: Vec<(String, VarStyle, SavedData)> = self
+            .vars
+            .iter()
+            .map(|(name, v)| {
+                let data = match &v.data {
+                    Data::List { values, which } => SavedData::List { values: values.clone(), which: *which },
+                    Data::Loop { first, last, which, pad } => SavedData::Loop { first: *first, last: *last, which: *which, pad: *pad },
+                    Data::Str(s) => SavedData::Str(s.clone()),
+                    Data::Getenv(s) => SavedData::Getenv(s.clone()),
+                    Data::Format { var, fmt } => SavedData::Format { var: var.clone(), fmt: fmt.clone() },
+                    Data::Formula { text, .. } => SavedData::Formula(text.clone()),
+                    Data::Internal(x) => SavedData::Internal(*x),
+                };
+                (name.clone(), v.style, data)
+            })
+            .collect();
+        vars.sort_by(|a, b| a.0.cmp(&b.0));
+        SavedVariables { vars, rng: self.rng.0.lock().map(|g| *g).unwrap_or(None) }
+    }
+
+    /// The store a checkpoint kept ([`Variables::save`]).
+    pub fn restore(saved: &SavedVariables) -> std::result::Result<Variables, String> {
+        let mut out = Variables::default();
+        for (name, style, data) in &saved.vars {
+            let data = match data {
+                SavedData::List { values, which } => Data::List { values: values.clone(), which: *which },
+                SavedData::Loop { first, last, which, pad } => Data::Loop { first: *first, last: *last, which: *which, pad: *pad },
+                SavedData::Str(s) => Data::Str(s.clone()),
+                SavedData::Getenv(s) => Data::Getenv(s.clone()),
+                SavedData::Format { var, fmt } => Data::Format { var: var.clone(), fmt: fmt.clone() },
+                SavedData::Formula(text) => {
+                    let e = expr::parse(text).map_err(|m| format!("variable {name}: {m}"))?;
+                    Data::Formula { text: text.clone(), expr: Arc::new(e) }
+                }
+                SavedData::Internal(x) => Data::Internal(*x),
+            };
+            out.vars.insert(name.clone(), Var { style: *style, data });
+        }
+        out.rng = Rng(Mutex::new(saved.rng));
+        Ok(out)
     }
 
     /// The style of a variable, `None` if it is not defined.

@@ -1,0 +1,508 @@
+//! `demx campaign FILE [--jobs J] [--status] [--stop]`: a declared matrix
+//! of runs (deck, variables) that survives stops and moves between
+//! machines with the repository.
+//!
+//! The campaign file (JSON) names the deck (relative to the file), the
+//! variables every run takes, and the runs, each with its own variables
+//! and an estimate of its cost:
+//!
+//! ```json
+//! { "deck": "../../../templates/heap/in.heap", "dump": "dump.heap", "measure": "repose",
+//!   "checkpoint_every_s": 600, "vars": { "Y": "63e9", "model": "paper" },
+//!   "runs": [ { "name": "earth_d1000", "vars": { "d": "1e-3", "g": "1" }, "estimate_core_h": 1.8 } ] }
+//! ```
+//!
+//! Each run lives in `runs/NAME/` beside the file: `ckpt/checkpoint.json.gz`
+//! while it is unfinished (`demx run --checkpoint`, every
+//! `checkpoint_every_s` of wall time and when stopped), then `result.json`
+//! (the measurement, the particle-steps, the wall time and which binary ran
+//! which stretch) and `final.dump.gz` (the last frame of its dump); the
+//! checkpoint is removed then. What the run writes as it goes is kept in
+//! `runs/NAME/work/`, which is not meant to be committed. Committing `runs/`
+//! at a stop is all it takes to carry the campaign over: the next start, on
+//! any machine, continues each unfinished run from its checkpoint, bit for
+//! bit as if it had not stopped.
+//!
+//! Runs go one per core (`--jobs`, default 1), one thread each. `--stop`
+//! (or SIGTERM to the runner) asks every running run to stop at its next
+//! checkpoint; `--status` prints what is done, resumable and pending, with
+//! the core-hours left by the estimates.
+
+use super::repose::{pick_frame, repose};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+/// One run of the matrix.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// Folder name under `runs/`.
+    pub name: String,
+    /// Its own variables (over the campaign's).
+    #[serde(default)]
+    pub vars: BTreeMap<String, String>,
+    /// Estimated cost, core-hours (for `--status`).
+    #[serde(default)]
+    pub estimate_core_h: f64,
+    /// Its own deck, dump and measure, where they differ from the campaign's.
+    #[serde(default)]
+    pub deck: Option<PathBuf>,
+    /// See [`RunSpec::deck`].
+    #[serde(default)]
+    pub dump: Option<String>,
+    /// See [`RunSpec::deck`].
+    #[serde(default)]
+    pub measure: Option<String>,
+}
+
+/// A campaign file.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Campaign {
+    /// The deck, relative to the campaign file.
+    pub deck: PathBuf,
+    /// The dump whose last frame is measured.
+    #[serde(default = "default_dump")]
+    pub dump: String,
+    /// What is measured: `repose` (theta_r) or `packing` (phi) or `both`.
+    #[serde(default = "default_measure")]
+    pub measure: String,
+    /// Wall-clock seconds between checkpoints.
+    #[serde(default = "default_every")]
+    pub checkpoint_every_s: f64,
+    /// Variables every run takes.
+    #[serde(default)]
+    pub vars: BTreeMap<String, String>,
+    /// The runs, in the order they are started.
+    pub runs: Vec<RunSpec>,
+}
+
+fn default_dump() -> String {
+    "dump.heap".into()
+}
+fn default_measure() -> String {
+    "repose".into()
+}
+fn default_every() -> f64 {
+    600.0
+}
+
+/// A finished run (`result.json`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunOutcome {
+    /// The run's name.
+    pub name: String,
+    /// All its variables (campaign's and its own).
+    pub vars: BTreeMap<String, String>,
+    /// theta_r (mean of the two projections), degrees.
+    pub theta_deg: Option<f64>,
+    /// SD of the two projections, degrees.
+    pub theta_sd_deg: Option<f64>,
+    /// Packing fraction (whole cross-section between 0.3 and 0.7 z_max).
+    pub phi: Option<f64>,
+    /// Particles in the last frame.
+    pub particles: usize,
+    /// Sum over the deck's runs of steps x particles at each run's end.
+    pub particle_steps: f64,
+    /// Wall time over all stretches, s.
+    pub wall_s: f64,
+    /// Core-hours (one thread per run).
+    pub core_hours: f64,
+    /// Which binary ran which stretch.
+    pub segments: Vec<crate::scene::checkpoint::Segment>,
+    /// When it finished (seconds since the Unix epoch).
+    pub finished_unix: u64,
+}
+
+#[derive(clap::Parser, Debug)]
+#[command(name = "demx campaign", about = "Run a declared matrix of runs that survives stops (see the module's text)")]
+struct Cli {
+    /// The campaign file (JSON).
+    file: PathBuf,
+    /// Runs at a time (one thread each).
+    #[arg(long, default_value_t = 1)]
+    jobs: usize,
+    /// Print what is done, resumable and pending, and the core-hours left.
+    #[arg(long)]
+    status: bool,
+    /// Ask a running campaign to stop at its runs' next checkpoints.
+    #[arg(long)]
+    stop: bool,
+    /// Start at most this many runs, then wait for them (tests).
+    #[arg(long)]
+    max_runs: Option<usize>,
+    /// Extra arguments for every `demx run` (e.g. `--checkpoint-stop-after 2`, tests).
+    #[arg(long, allow_hyphen_values = true)]
+    run_arg: Vec<String>,
+}
+
+/// A campaign's folder, file and runs.
+struct Place {
+    dir: PathBuf,
+    c: Campaign,
+}
+
+impl Place {
+    fn load(file: &Path) -> Result<Place, String> {
+        let text = std::fs::read_to_string(file).map_err(|e| format!("{}: {e}", file.display()))?;
+        let c: Campaign = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", file.display()))?;
+        let mut seen = std::collections::HashSet::new();
+        for r in &c.runs {
+            let ok = !r.name.is_empty() && r.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "_-.".contains(ch)) && !r.name.starts_with('.');
+            if !ok {
+                return Err(format!("{}: run name '{}' is not a plain folder name", file.display(), r.name));
+            }
+            if !seen.insert(r.name.clone()) {
+                return Err(format!("{}: run '{}' is declared twice", file.display(), r.name));
+            }
+        }
+        if !(c.checkpoint_every_s.is_finite() && c.checkpoint_every_s >= 0.0) {
+            return Err(format!("{}: checkpoint_every_s must be >= 0", file.display()));
+        }
+        let dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
+        Ok(Place { dir, c })
+    }
+    fn run_dir(&self, r: &RunSpec) -> PathBuf {
+        self.dir.join("runs").join(&r.name)
+    }
+    fn deck(&self, r: &RunSpec) -> PathBuf {
+        self.dir.join(r.deck.as_ref().unwrap_or(&self.c.deck))
+    }
+    fn dump<'a>(&'a self, r: &'a RunSpec) -> &'a str {
+        r.dump.as_deref().unwrap_or(&self.c.dump)
+    }
+    fn measure<'a>(&'a self, r: &'a RunSpec) -> &'a str {
+        r.measure.as_deref().unwrap_or(&self.c.measure)
+    }
+    fn vars(&self, r: &RunSpec) -> BTreeMap<String, String> {
+        let mut v = self.c.vars.clone();
+        v.extend(r.vars.clone());
+        v
+    }
+}
+
+/// Where a run stands.
+enum State {
+    Done(Box<RunOutcome>),
+    Resumable { step: i64, wall_s: f64 },
+    Failed(String),
+    Pending,
+}
+
+fn state(p: &Place, r: &RunSpec) -> State {
+    let dir = p.run_dir(r);
+    if let Ok(text) = std::fs::read_to_string(dir.join("result.json")) {
+        if let Ok(o) = serde_json::from_str::<RunOutcome>(&text) {
+            return State::Done(Box::new(o));
+        }
+    }
+    if let Ok(text) = std::fs::read_to_string(dir.join("failed.txt")) {
+        return State::Failed(text.lines().next().unwrap_or("").to_string());
+    }
+    let ck = dir.join("ckpt").join(crate::scene::checkpoint::FILE);
+    if let Some((step, wall_s)) = checkpoint_progress(&ck) {
+        return State::Resumable { step, wall_s };
+    }
+    State::Pending
+}
+
+/// The step and the wall time so far of a checkpoint file.
+fn checkpoint_progress(path: &Path) -> Option<(i64, f64)> {
+    #[derive(Deserialize)]
+    struct Head {
+        segments: Vec<crate::scene::checkpoint::Segment>,
+    }
+    let f = std::fs::File::open(path).ok()?;
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(f).read_to_string(&mut text).ok()?;
+    let h: Head = serde_json::from_str(&text).ok()?;
+    let step = h.segments.last().map_or(0, |s| s.to_step);
+    Some((step, h.segments.iter().map(|s| s.wall_s).sum()))
+}
+
+/// Entry point.
+pub fn cli(args: Vec<String>) -> ExitCode {
+    use clap::Parser;
+    let cli = match Cli::try_parse_from(std::iter::once("demx campaign".to_string()).chain(args)) {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    let p = match Place::load(&cli.file) {
+        Ok(p) => p,
+        Err(m) => {
+            eprintln!("error: {m}");
+            return ExitCode::from(2);
+        }
+    };
+    if cli.stop {
+        return match std::fs::write(p.dir.join("STOP"), "") {
+            Ok(()) => {
+                println!("asked the campaign in {} to stop at its runs' next checkpoints", p.dir.display());
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: cannot write {}: {e}", p.dir.join("STOP").display());
+                ExitCode::from(1)
+            }
+        };
+    }
+    if cli.status {
+        print_status(&p);
+        return ExitCode::SUCCESS;
+    }
+    run(&p, &cli)
+}
+
+fn print_status(p: &Place) {
+    let (mut done, mut partial, mut pending, mut failed) = (0, 0, 0, 0);
+    let mut left = 0.0;
+    for r in &p.c.runs {
+        match state(p, r) {
+            State::Done(o) => {
+                done += 1;
+                let th = o.theta_deg.map_or(String::new(), |t| format!("theta_r {t:.2} ± {:.2}°  ", o.theta_sd_deg.unwrap_or(f64::NAN)));
+                let phi = o.phi.map_or(String::new(), |f| format!("phi {f:.4}  "));
+                println!("{:<28} done       {th}{phi}{:.2} core-h", r.name, o.core_hours);
+            }
+            State::Resumable { step, wall_s } => {
+                partial += 1;
+                left += (r.estimate_core_h - wall_s / 3600.0).max(0.0);
+                println!("{:<28} resumable  at step {step}, {:.2} core-h spent of ~{:.1}", r.name, wall_s / 3600.0, r.estimate_core_h);
+            }
+            State::Failed(m) => {
+                failed += 1;
+                println!("{:<28} FAILED     {m}", r.name);
+            }
+            State::Pending => {
+                pending += 1;
+                left += r.estimate_core_h;
+                println!("{:<28} pending    ~{:.1} core-h", r.name, r.estimate_core_h);
+            }
+        }
+    }
+    println!("{done} done, {partial} resumable, {pending} pending, {failed} failed; about {left:.1} core-hours left");
+}
+
+/// SIGTERM or the campaign's STOP file.
+fn stop_asked(p: &Place) -> bool {
+    crate::scene::checkpoint::term_received() || p.dir.join("STOP").exists()
+}
+
+/// The campaign's lock: the pid of the runner that holds it.
+const LOCK: &str = "runner.pid";
+
+/// Whether another live runner holds the campaign (its pid in [`LOCK`]).
+fn held_by_other(p: &Place) -> Option<i32> {
+    let pid: i32 = std::fs::read_to_string(p.dir.join(LOCK)).ok()?.trim().parse().ok()?;
+    // SAFETY: signal 0 only asks whether the process exists
+    let alive = pid > 0 && pid != std::process::id() as i32 && unsafe { libc::kill(pid, 0) } == 0;
+    alive.then_some(pid)
+}
+
+fn run(p: &Place, cli: &Cli) -> ExitCode {
+    if let Some(pid) = held_by_other(p) {
+        eprintln!("error: the campaign in {} is already running (runner pid {pid}); `--stop` stops it", p.dir.display());
+        return ExitCode::from(2);
+    }
+    if let Err(e) = std::fs::write(p.dir.join(LOCK), std::process::id().to_string()) {
+        eprintln!("error: cannot write {}: {e}", p.dir.join(LOCK).display());
+        return ExitCode::from(1);
+    }
+    let code = run_locked(p, cli);
+    let _ = std::fs::remove_file(p.dir.join(LOCK));
+    code
+}
+
+fn run_locked(p: &Place, cli: &Cli) -> ExitCode {
+    crate::scene::checkpoint::catch_term();
+    let _ = std::fs::remove_file(p.dir.join("STOP"));
+    let exe = match std::env::current_exe() {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("error: cannot find the demx executable: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    for r in &p.c.runs {
+        if let Err(e) = p.deck(r).canonicalize() {
+            eprintln!("error: deck {} of run {}: {e}", p.deck(r).display(), r.name);
+            return ExitCode::from(2);
+        }
+    }
+    let mut queue: Vec<&RunSpec> = p.c.runs.iter().filter(|r| matches!(state(p, r), State::Resumable { .. } | State::Pending)).collect();
+    // unfinished runs first: their checkpoints are what a stop carries over
+    queue.sort_by_key(|r| !matches!(state(p, r), State::Resumable { .. }));
+    queue.truncate(cli.max_runs.unwrap_or(usize::MAX));
+    let mut running: Vec<(&RunSpec, std::process::Child, Instant)> = vec![];
+    let mut failures = 0;
+    let mut stopping = false;
+    loop {
+        if !stopping && stop_asked(p) {
+            stopping = true;
+            for (r, _, _) in &running {
+                let _ = std::fs::write(p.run_dir(r).join("ckpt").join("STOP"), "");
+            }
+            println!("campaign: stopping; each run stops at its next checkpoint");
+        }
+        while !stopping && running.len() < cli.jobs.max(1) && !queue.is_empty() {
+            let r = queue.remove(0);
+            match start(p, r, &exe, &cli.run_arg) {
+                Ok(child) => {
+                    println!("campaign: {} started", r.name);
+                    running.push((r, child, Instant::now()));
+                }
+                Err(m) => {
+                    eprintln!("campaign: {}: {m}", r.name);
+                    failures += 1;
+                }
+            }
+        }
+        if running.is_empty() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(200));
+        let mut k = 0;
+        while k < running.len() {
+            let exited = running[k].1.try_wait();
+            match exited {
+                Ok(None) => k += 1,
+                Ok(Some(status)) => {
+                    let (r, _, t0) = running.remove(k);
+                    let dir = p.run_dir(r);
+                    let _ = std::fs::remove_file(dir.join("ckpt").join("STOP"));
+                    match status.code() {
+                        Some(0) => match finish(p, r) {
+                            Ok(o) => println!(
+                                "campaign: {} done in {:.0} s: {}",
+                                r.name,
+                                t0.elapsed().as_secs_f64(),
+                                o.theta_deg.map_or(String::new(), |t| format!("theta_r {t:.2}°"))
+                            ),
+                            Err(m) => {
+                                failures += 1;
+                                let _ = std::fs::write(dir.join("failed.txt"), &m);
+                                eprintln!("campaign: {}: {m}", r.name);
+                            }
+                        },
+                        Some(c) if c == crate::scene::checkpoint::STOPPED as i32 => println!("campaign: {} stopped at a checkpoint", r.name),
+                        _ => {
+                            failures += 1;
+                            let m = format!("demx run exited with {status} (see {})", dir.join("work").join("log.demx").display());
+                            let _ = std::fs::write(dir.join("failed.txt"), &m);
+                            eprintln!("campaign: {}: {m}", r.name);
+                        }
+                    }
+                }
+                Err(e) => {
+                    eprintln!("campaign: {}: {e}", running[k].0.name);
+                    k += 1;
+                }
+            }
+        }
+    }
+    let _ = std::fs::remove_file(p.dir.join("STOP"));
+    print_status(p);
+    if failures > 0 {
+        ExitCode::from(1)
+    } else if stopping {
+        ExitCode::from(crate::scene::checkpoint::STOPPED)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// Start (or continue) one run.
+fn start(p: &Place, r: &RunSpec, exe: &Path, extra: &[String]) -> Result<std::process::Child, String> {
+    let deck = p.deck(r).canonicalize().map_err(|e| format!("deck {}: {e}", p.deck(r).display()))?;
+    let dir = p.run_dir(r);
+    let work = dir.join("work");
+    std::fs::create_dir_all(&work).map_err(|e| format!("cannot create {}: {e}", work.display()))?;
+    let ckpt = dir.join("ckpt").canonicalize().unwrap_or_else(|_| std::env::current_dir().unwrap_or_default().join(dir.join("ckpt")));
+    let mut cmd = std::process::Command::new(exe);
+    cmd.current_dir(&work).arg("run").arg(deck).args(["--threads", "1", "--quiet", "--log", "log.demx"]);
+    cmd.arg("--checkpoint").arg(&ckpt).arg("--checkpoint-every").arg(p.c.checkpoint_every_s.to_string());
+    cmd.args(extra);
+    for (k, v) in p.vars(r) {
+        cmd.arg("-var").arg(k).arg(v);
+    }
+    cmd.stdout(std::process::Stdio::null()).stderr(std::fs::File::create(work.join("stderr.txt")).map_err(|e| e.to_string())?);
+    cmd.spawn().map_err(|e| format!("cannot start demx run: {e}"))
+}
+
+/// Measure a finished run, keep its result and last frame, remove its
+/// checkpoint and working files.
+fn finish(p: &Place, r: &RunSpec) -> Result<RunOutcome, String> {
+    let dir = p.run_dir(r);
+    let work = dir.join("work");
+    let dump = work.join(p.dump(r));
+    let frame = pick_frame(&dump.to_string_lossy(), None).map_err(|e| format!("{}: {e}", dump.display()))?;
+    let (mut theta, mut sd, mut phi) = (None, None, None);
+    if matches!(p.measure(r), "repose" | "both") {
+        let rep = repose(&frame).map_err(|e| format!("{}: {e}", dump.display()))?;
+        theta = Some(rep.theta);
+        sd = Some(rep.sd);
+    }
+    if matches!(p.measure(r), "packing" | "both") {
+        phi = Some(super::packing::packing(&frame).map_err(|e| format!("{}: {e}", dump.display()))?.phi);
+    }
+    let log = std::fs::read_to_string(work.join("log.demx")).unwrap_or_default();
+    let particle_steps = particle_steps(&log);
+    let segs_path = dir.join("ckpt").join("segments.json");
+    let segments: Vec<crate::scene::checkpoint::Segment> = std::fs::read_to_string(&segs_path)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .ok_or_else(|| format!("{} is missing", segs_path.display()))?;
+    let wall_s: f64 = segments.iter().map(|s| s.wall_s).sum();
+    let o = RunOutcome {
+        name: r.name.clone(),
+        vars: p.vars(r),
+        theta_deg: theta,
+        theta_sd_deg: sd,
+        phi,
+        particles: frame.natoms,
+        particle_steps,
+        wall_s,
+        core_hours: segments.iter().map(|s| s.wall_s * s.threads as f64).sum::<f64>() / 3600.0,
+        segments,
+        finished_unix: std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()),
+    };
+    // the last frame, gzipped
+    let frame_text = last_frame_text(&dump).map_err(|e| format!("{}: {e}", dump.display()))?;
+    let gz = std::fs::File::create(dir.join("final.dump.gz")).map_err(|e| e.to_string())?;
+    let mut enc = flate2::write::GzEncoder::new(gz, flate2::Compression::best());
+    std::io::Write::write_all(&mut enc, frame_text.as_bytes()).map_err(|e| e.to_string())?;
+    enc.finish().map_err(|e| e.to_string())?;
+    let text = serde_json::to_string_pretty(&o).map_err(|e| e.to_string())?;
+    std::fs::write(dir.join("result.json"), text + "\n").map_err(|e| e.to_string())?;
+    let _ = std::fs::remove_dir_all(dir.join("ckpt"));
+    let _ = std::fs::remove_dir_all(&work);
+    Ok(o)
+}
+
+/// Sum of steps x atoms over the log's "Loop time ... for N steps with M
+/// atoms" lines.
+pub fn particle_steps(log: &str) -> f64 {
+    log.lines()
+        .filter_map(|l| {
+            let rest = l.strip_prefix("Loop time of ")?;
+            let w: Vec<&str> = rest.split_whitespace().collect();
+            let k = w.iter().position(|x| *x == "steps")?;
+            let n: f64 = w.get(k.checked_sub(1)?)?.parse().ok()?;
+            let m: f64 = w.get(k + 2)?.parse().ok()?;
+            Some(n * m)
+        })
+        .sum()
+}
+
+/// The text of a dump's last frame.
+fn last_frame_text(path: &Path) -> std::io::Result<String> {
+    let text = std::fs::read_to_string(path)?;
+    let start = text.rfind("ITEM: TIMESTEP").ok_or_else(|| std::io::Error::other("no frame"))?;
+    Ok(text[start..].to_string())
+}
