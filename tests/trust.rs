@@ -108,7 +108,10 @@ fn demx(dir: &std::path::Path, args: &[&str]) -> (Option<i32>, String) {
 fn dump_text(frames: &[(u64, Vec<[f64; 5]>)]) -> String {
     let mut t = String::new();
     for (step, rows) in frames {
-        t.push_str(&format!("ITEM: TIMESTEP\n{step}\nITEM: NUMBER OF ATOMS\n{}\nITEM: BOX BOUNDS pp pp ff\n0 0.1\n0 0.1\n0 0.1\nITEM: ATOMS id x y z radius\n", rows.len()));
+        t.push_str(&format!(
+            "ITEM: TIMESTEP\n{step}\nITEM: NUMBER OF ATOMS\n{}\nITEM: BOX BOUNDS pp pp ff\n0 0.1\n0 0.1\n0 0.1\nITEM: ATOMS id x y z radius\n",
+            rows.len()
+        ));
         for r in rows {
             t.push_str(&format!("{} {} {} {} {}\n", r[0], r[1], r[2], r[3], r[4]));
         }
@@ -118,10 +121,12 @@ fn dump_text(frames: &[(u64, Vec<[f64; 5]>)]) -> String {
 
 /// 30 grains of a small heap, ids 1..=30.
 fn heap_rows() -> Vec<[f64; 5]> {
-    (0..30).map(|k| {
-        let (i, j) = ((k % 6) as f64, (k / 6) as f64);
-        [k as f64 + 1.0, 0.03 + 0.008 * i, 0.05, 0.001 + 0.004 * j + 0.001 * (i - 2.5).abs(), 0.001]
-    }).collect()
+    (0..30)
+        .map(|k| {
+            let (i, j) = ((k % 6) as f64, (k / 6) as f64);
+            [k as f64 + 1.0, 0.03 + 0.008 * i, 0.05, 0.001 + 0.004 * j + 0.001 * (i - 2.5).abs(), 0.001]
+        })
+        .collect()
 }
 
 #[test]
@@ -189,7 +194,8 @@ fn dump_headers_claiming_more_than_the_file_holds_do_not_allocate_it() {
     let dir = tempfile::tempdir().unwrap();
     // 4 kB that claim 16.7M atoms of 2,015 columns: aborted allocating 270 GB
     let cols: Vec<String> = (0..2015).map(|k| format!("c{k}")).collect();
-    let text = format!("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n16777216\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\nITEM: ATOMS {}\n", cols.join(" "));
+    let text =
+        format!("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n16777216\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\nITEM: ATOMS {}\n", cols.join(" "));
     std::fs::write(dir.path().join("big.dump"), &text).unwrap();
     let (code, out) = demx(dir.path(), &["compare", "big.dump", "big.dump"]);
     assert_eq!(code, Some(2), "{out}");
@@ -199,7 +205,11 @@ fn dump_headers_claiming_more_than_the_file_holds_do_not_allocate_it() {
 #[test]
 fn reference_engines_are_not_started_on_decks_that_run_commands() {
     let dir = tempfile::tempdir().unwrap();
-    for (name, line) in [("in.shell", "shell touch pwned"), ("in.if", "if \"1 > 0\" then \"shell touch pwned\""), ("in.py", "python hello here \"open('pwned','w')\"")] {
+    for (name, line) in [
+        ("in.shell", "shell touch pwned"),
+        ("in.if", "if \"1 > 0\" then \"shell touch pwned\""),
+        ("in.py", "python hello here \"open('pwned','w')\""),
+    ] {
         std::fs::write(dir.path().join(name), deck(&format!("{line}\nrun 1"))).unwrap();
         for args in [vec!["compare", name, "--against", "lammps"], vec!["reference", name, "--engine", "lammps", "--out", "ref"]] {
             let (code, out) = demx(dir.path(), &args);

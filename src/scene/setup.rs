@@ -217,7 +217,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             let r = region(s, rw)?;
             let (lo, hi) = r.bbox().ok_or_else(|| Error::deck(rw.span, format!("create_box: region '{}' has no finite bounding box", rw.text)))?;
             // both engines: "Box bounds are invalid or missing"
-            if let Some(d) = (0..3).find(|&d| !(hi[d] > lo[d])) {
+            if let Some(d) = (0..3).find(|&d| hi[d].is_nan() || lo[d].is_nan() || hi[d] <= lo[d]) {
                 let axis = ["x", "y", "z"][d];
                 return Err(Error::deck(rw.span, format!("create_box: region '{}' is empty in {axis} ({axis}lo {} >= {axis}hi {})", rw.text, lo[d], hi[d])).with_hint("LAMMPS and LIGGGHTS: Box bounds are invalid or missing"));
             }
@@ -664,9 +664,9 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         // set.cpp): "Invalid density/diameter/mass in set command", "Invalid
         // value in set command" for a type outside the box's types
         let bad = match k.text.as_str() {
-            "density" if !(val > 0.0) => Some("density must be > 0".to_string()),
-            "diameter" if !(val >= 0.0) => Some("diameter must be >= 0".to_string()),
-            "mass" if !(val > 0.0) => Some("mass must be > 0".to_string()),
+            "density" if val.is_nan() || val <= 0.0 => Some("density must be > 0".to_string()),
+            "diameter" if val.is_nan() || val < 0.0 => Some("diameter must be >= 0".to_string()),
+            "mass" if val.is_nan() || val <= 0.0 => Some("mass must be > 0".to_string()),
             "type" if val.fract() != 0.0 || val < 1.0 || val > s.sim.ntypes as f64 => Some(format!("type must be an atom type 1..{}", s.sim.ntypes)),
             _ => None,
         };
