@@ -113,12 +113,13 @@ impl Error {
     }
     /// Short one-line message without location.
     pub fn message(&self) -> String {
-        match self {
+        let m = match self {
             Error::Deck { msg, .. } => msg.clone(),
             Error::Unsupported { what, .. } => format!("{what} is not supported yet"),
             Error::Io { what, err, .. } => format!("{what}: {err}"),
             Error::Runtime { msg } | Error::Usage { msg } => msg.clone(),
-        }
+        };
+        tidy(&m)
     }
     /// Render as `file:line:col: error: msg`, the source line and a caret,
     /// LAMMPS `point_to_error` style.
@@ -138,15 +139,23 @@ impl Error {
                 out.push_str(&format!("{}:{}:{}: {}: {}\n", f.path.display(), line, col, label, self.message()));
                 let text = f.line_text(line);
                 let lno = line.to_string();
-                out.push_str(&format!("{} | {}\n", lno, text.replace('\t', " ")));
                 let (eline, ecol) = f.line_col((s.end as usize).max(s.start as usize + 1) - 1);
                 let width = if eline == line { (ecol + 1).saturating_sub(col).max(1) } else { 1 };
-                out.push_str(&format!("{} | {}{}\n", " ".repeat(lno.len()), " ".repeat(col - 1), "^".repeat(width)));
+                // a window of at most 240 characters around the caret, control
+                // characters shown as '?' so that the caret stays aligned
+                let skip = (col - 1).saturating_sub(40);
+                let shown: String = text.chars().skip(skip).take(240).map(|c| if c.is_control() { '?' } else { c }).collect();
+                let more = if text.chars().count() > skip + 240 { " ..." } else { "" };
+                let lead = if skip > 0 { "... " } else { "" };
+                out.push_str(&format!("{} | {lead}{shown}{more}\n", lno));
+                let pad = col - 1 - skip + lead.len();
+                let width = width.min(240usize.saturating_sub(col - 1 - skip)).max(1);
+                out.push_str(&format!("{} | {}{}\n", " ".repeat(lno.len()), " ".repeat(pad), "^".repeat(width)));
             }
             None => out.push_str(&format!("{}: {}\n", label, self.message())),
         }
         if let Some(h) = hint {
-            out.push_str(&format!("hint: {h}\n"));
+            out.push_str(&format!("hint: {}\n", tidy(h)));
         }
         out
     }
@@ -160,12 +169,64 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// `s` with its control characters but newline and tab written as escapes (`\x1b`), so
+/// that a token in a message cannot move the cursor or recolour the
+/// terminal.
+pub fn printable(s: &str) -> String {
+    let bad = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !s.chars().any(bad) {
+        return s.to_string();
+    }
+    s.chars().map(|c| if bad(c) { format!("\\x{:02x}", c as u32) } else { c.to_string() }).collect()
+}
+
+/// `s` cut to `max` characters (its head and tail, with the number left out)
+/// for messages: a 10 MB token made a 20 MB message.
+pub fn clip(s: &str, max: usize) -> String {
+    let n = s.chars().count();
+    if n <= max {
+        return s.to_string();
+    }
+    let half = max / 2;
+    let head: String = s.chars().take(half).collect();
+    let tail: String = s.chars().skip(n - half).collect();
+    format!("{head}...[{} characters]...{tail}", n - 2 * half)
+}
+
+/// A message made safe to print: control characters escaped, every quoted
+/// ('...') token longer than 200 characters clipped, and the whole kept
+/// under 20,000 characters.
+fn tidy(msg: &str) -> String {
+    let mut out = String::with_capacity(msg.len().min(4096));
+    let mut rest = msg;
+    while let Some(a) = rest.find('\'') {
+        out.push_str(&rest[..=a]);
+        rest = &rest[a + 1..];
+        match rest.find('\'') {
+            Some(b) => {
+                out.push_str(&clip(&rest[..b], 200));
+                out.push('\'');
+                rest = &rest[b + 1..];
+            }
+            None => break,
+        }
+    }
+    out.push_str(rest);
+    printable(&clip(&out, 20_000))
+}
+
 /// Closest candidate to `word` by edit distance, for "did you mean" hints.
 pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     let mut best: Option<(usize, &str)> = None;
+    let limit = (word.len().max(3) / 3).max(2);
     for c in candidates {
+        // the distance is at least the difference in length: skip the
+        // quadratic comparison (a 10 MB token took 20 s over every command)
+        if word.len().abs_diff(c.len()) > limit {
+            continue;
+        }
         let d = edit_distance(word, c);
-        if d <= (word.len().max(3) / 3).max(2) && best.map_or(true, |(bd, _)| d < bd) {
+        if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
             best = Some((d, c));
         }
     }

@@ -19,5 +19,6 @@ pub mod analysis;
 pub mod convert;
 pub mod cli;
 pub mod plot;
+pub mod limits;
 
 pub use error::{Error, Result};

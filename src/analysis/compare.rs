@@ -109,7 +109,7 @@ pub struct Series {
 fn read_dump(path: &Path, out: &mut BTreeMap<u64, Snap>, notes: &mut Vec<String>) -> Result<()> {
     let rd = DumpReader::open(path)?;
     let mut any = false;
-    for fr in rd {
+    for (k, fr) in rd.enumerate() {
         let fr = match fr {
             Ok(f) => f,
             Err(e) if any && e.message().contains("truncated") => {
@@ -122,9 +122,49 @@ fn read_dump(path: &Path, out: &mut BTreeMap<u64, Snap>, notes: &mut Vec<String>
         let s = Snap::from_frame(&fr).ok_or_else(|| {
             Error::usage(format!("{}: frame at timestep {} has no id and x y z (or xu yu zu, xs ys zs) columns", path.display(), fr.timestep))
         })?;
+        check_snap(path, k + 1, &fr, &s)?;
         if out.insert(s.timestep, s).is_some() {
             notes.push(format!("{}: timestep {} appears more than once; the last frame is used", path.display(), fr.timestep));
         }
+    }
+    Ok(())
+}
+
+/// A frame that cannot be compared is an input error (exit 2) naming the
+/// file, the frame and the particle: ids that are not positive integers or
+/// that repeat (matching by id would pair the wrong particles, and 999 of
+/// 1000 ids set to 1 read as 999 lost particles and a PASS), positions,
+/// velocities or radii that are not finite, negative radii.
+fn check_snap(path: &Path, frame: usize, fr: &Frame, s: &Snap) -> Result<()> {
+    let at = |row: usize| format!("{}: frame {frame} (timestep {}), atom line {}", path.display(), s.timestep, row + 1);
+    if let Some(c) = fr.col("id") {
+        let mut first: HashMap<u64, usize> = HashMap::with_capacity(s.ids.len());
+        for row in 0..fr.natoms {
+            let v = fr.get(row, c).unwrap_or(f64::NAN);
+            if !(v >= 1.0 && v.fract() == 0.0 && v < 9.0e15) {
+                return Err(Error::usage(format!("{}: id {v} is not a positive integer", at(row))));
+            }
+            if let Some(r0) = first.insert(v as u64, row) {
+                let n = s.ids.iter().filter(|&&i| i == v as u64).count();
+                return Err(Error::usage(format!(
+                    "{}: particle id {} appears {n} times in the frame (first on atom line {}); ids must be unique to match particles",
+                    at(row),
+                    v as u64,
+                    r0 + 1
+                )));
+            }
+        }
+    }
+    let bad3 = |v: &[[f64; 3]]| v.iter().position(|p| p.iter().any(|c| !c.is_finite()));
+    for (what, col) in [("position", Some(&s.x)), ("velocity", s.v.as_ref()), ("angular velocity", s.w.as_ref())] {
+        if let Some(row) = col.and_then(|v| bad3(v)) {
+            let p = col.map_or([0.0; 3], |v| v[row]);
+            return Err(Error::usage(format!("{}: particle {} has a {what} that is not finite ({} {} {})", at(row), s.ids[row], p[0], p[1], p[2])));
+        }
+    }
+    if let Some(row) = s.r.as_ref().and_then(|r| r.iter().position(|&r| !(r >= 0.0 && r.is_finite()))) {
+        let r = s.r.as_ref().map_or(0.0, |r| r[row]);
+        return Err(Error::usage(format!("{}: particle {} has radius {r}; radii must be finite and >= 0", at(row), s.ids[row])));
     }
     Ok(())
 }
@@ -518,6 +558,10 @@ pub fn compare_series(a: &Series, b: &Series, o: &CompareOptions) -> Comparison 
         Mode::Statistics => {
             if let Some(f) = counts_differ {
                 failures.push(format!("particle count differs at timestep {}: {} vs {}", f.timestep, f.a.count, f.b.count));
+            } else if !only_a.is_empty() || !only_b.is_empty() {
+                // same counts, other ids: particles vanished from one run and
+                // others appeared, which no deck explains
+                failures.push(format!("particle ids differ: {} only in A, {} only in B", only_a.len(), only_b.len()));
             }
             if ke_dev > o.tol_ke {
                 failures.push(format!("kinetic energy differs by {ke_dev:.3e} of the peak (tolerance {})", o.tol_ke));
@@ -757,6 +801,10 @@ pub struct CompareArgs {
     /// Run the deck with demx and this engine, then compare.
     #[arg(long, value_enum)]
     pub against: Option<super::reference::RefEngine>,
+    /// With --against: run decks with `shell` or `python` commands (the
+    /// engine runs them).
+    #[arg(long)]
+    pub allow_shell: bool,
     /// Seeds per engine for chaotic decks (passed as -var SEEDVAR k).
     #[arg(long, default_value_t = 1)]
     pub seeds: usize,

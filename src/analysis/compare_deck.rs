@@ -236,7 +236,7 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode> {
         return Err(Error::usage(format!("--seeds: at most {}", SEEDS.len())));
     }
     let deck = Path::new(&args.a);
-    let prep = prepare_deck(deck, engine)?;
+    let prep = prepare_deck(deck, engine, args.allow_shell)?;
     let tmp = tempfile::tempdir().map_err(|e| Error::io(Span::DUMMY, "cannot create a temporary directory", &e))?;
     let root = args.keep.clone().unwrap_or_else(|| tmp.path().to_path_buf());
     let mut runs = vec![];

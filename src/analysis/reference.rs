@@ -180,9 +180,17 @@ fn format_lines(id: &str, dumps: &std::collections::HashMap<String, (bool, Optio
 
 /// Read `deck`, switch its dumps to full precision and find the files it
 /// names that exist beside it.
-pub fn prepare_deck(deck: &Path, engine: RefEngine) -> Result<PreparedDeck> {
+///
+/// Unless `allow_shell`, a deck (or a file it names) that runs system
+/// commands or Python (`shell`, `python`, `variable ... python`, `fix
+/// python/...`, also inside `if ... then "..."`) is refused before any
+/// engine starts: the engine would run them before demx read the deck.
+pub fn prepare_deck(deck: &Path, engine: RefEngine, allow_shell: bool) -> Result<PreparedDeck> {
     let text = std::fs::read_to_string(deck)
         .map_err(|e| Error::io(Span::DUMMY, format!("cannot read deck '{}'", deck.display()), &e))?;
+    if !allow_shell {
+        refuse_system_commands(deck, &text, engine)?;
+    }
     let dir = deck.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let deck_name = deck.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "in.deck".into());
     let mut files: Vec<(PathBuf, PathBuf)> = vec![];
@@ -197,8 +205,59 @@ pub fn prepare_deck(deck: &Path, engine: RefEngine) -> Result<PreparedDeck> {
             }
         }
     }
+    if !allow_shell {
+        // an `include`d file runs as well; any text file the deck names is
+        // read as a deck (a data or mesh file has no such words)
+        for (_, src) in &files {
+            if let Ok(t) = std::fs::read_to_string(src) {
+                refuse_system_commands(src, &t, engine)?;
+            }
+        }
+    }
     let (text, notes) = full_precision(&text, engine);
     Ok(PreparedDeck { deck_name, text, files, notes })
+}
+
+/// `path:line:col: error:` for the first command in `text` that would run a
+/// system command or Python in the engine: a line whose command (or a quoted
+/// command of `if`/`run every`) is `shell` or starts with `python`, or that
+/// names a `python` style (`variable v python f`, `pair_style python`).
+fn refuse_system_commands(path: &Path, text: &str, engine: RefEngine) -> Result<()> {
+    let mut logical = String::new();
+    let mut first_line = 0;
+    for (k, raw) in text.lines().enumerate() {
+        if logical.is_empty() {
+            first_line = k + 1;
+        }
+        let l = raw.trim_end();
+        if let Some(head) = l.strip_suffix('&') {
+            logical.push_str(head);
+            logical.push(' ');
+            continue;
+        }
+        logical.push_str(l);
+        let line = std::mem::take(&mut logical);
+        let ws = words(&line);
+        let runs = |w: &str| {
+            let cmd = w.split_whitespace().next().unwrap_or("");
+            cmd == "shell" || cmd.starts_with("python")
+        };
+        let hit = ws.first().is_some_and(|w| runs(w))
+            || ws.iter().skip(1).any(|w| w == "python" || w.starts_with("python/") || (w.contains(' ') && runs(w)));
+        if hit {
+            let what = ws.iter().find(|w| w.split_whitespace().next().is_some_and(|c| c == "shell" || c.starts_with("python"))).cloned().unwrap_or_default();
+            let col = line.find(what.split_whitespace().next().unwrap_or("")).map_or(1, |c| c + 1);
+            let kind = if what.starts_with("shell") { "a system command (shell)" } else { "Python code" };
+            return Err(Error::usage(format!(
+                "{}:{first_line}:{col}: `{}` runs {kind} in {}; demx read the deck first and starts no engine on it \
+                 (pass --allow-shell to run it anyway, if you trust the deck)",
+                path.display(),
+                crate::error::printable(&crate::error::clip(line.trim(), 200)),
+                engine.binary(),
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// How to run an engine.
@@ -371,6 +430,9 @@ pub struct ReferenceArgs {
     /// Output directory.
     #[arg(long, default_value = "reference-out")]
     pub out: PathBuf,
+    /// Run decks with `shell` or `python` commands (the engine runs them).
+    #[arg(long)]
+    pub allow_shell: bool,
     /// Variables (filled from `-var NAME VALUE...`).
     #[arg(skip)]
     pub vars: Vec<(String, Vec<String>)>,
@@ -417,7 +479,7 @@ pub struct ReferenceRecord {
 
 /// Run `demx reference`; returns the record (also written to `out`).
 pub fn reference(a: &ReferenceArgs) -> Result<ReferenceRecord> {
-    let prep = prepare_deck(&a.deck, a.engine)?;
+    let prep = prepare_deck(&a.deck, a.engine, a.allow_shell)?;
     let tmp = tempfile::tempdir().map_err(|e| Error::io(Span::DUMMY, "cannot create a temporary directory", &e))?;
     prep.install(tmp.path())?;
     let run = run_engine(tmp.path(), &prep.deck_name, &EngineRun { engine: a.engine, np: a.np.max(1), vars: a.vars.clone() })?;

@@ -235,6 +235,7 @@ pub(crate) fn pick_frame(path: &str, index: Option<i64>) -> Result<Frame> {
     if i < 0 || i >= n {
         return Err(Error::usage(format!("{path}: no frame {} ({n} frames)", index.unwrap_or(-1))));
     }
+    super::check_heap_frame(path, i as usize, &frames[i as usize])?;
     Ok(frames.swap_remove(i as usize))
 }
 

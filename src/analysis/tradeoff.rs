@@ -521,7 +521,8 @@ pub fn tradeoff(a: &TradeoffArgs, progress: &mut dyn FnMut(&str)) -> Result<Trad
     if k > SEEDS.len() {
         return Err(Error::usage(format!("--seeds: at most {}", SEEDS.len())));
     }
-    let prep = prepare_deck(&a.deck, RefEngine::Liggghts)?;
+    // only demx runs these variants, and demx refuses `shell` itself
+    let prep = prepare_deck(&a.deck, RefEngine::Liggghts, true)?;
     let installed: Vec<PathBuf> = prep.files.iter().map(|(r, _)| r.clone()).chain(std::iter::once(PathBuf::from(&prep.deck_name))).collect();
     let tmp = tempfile::tempdir().map_err(|e| Error::io(Span::DUMMY, "cannot create a temporary directory", &e))?;
     let root = a.keep.clone().unwrap_or_else(|| tmp.path().to_path_buf());

@@ -389,6 +389,10 @@ pub fn main() -> ExitCode {
                 print!("{}", i.render());
                 ExitCode::SUCCESS
             }
+            // a dump that cannot be read is bad input (exit 2), as for
+            // compare, repose and packing; an Io error without a deck span
+            // would say 1
+            Err(e @ crate::Error::Io { .. }) => report(&crate::Error::usage(e.message()), &SourceMap::new()),
             Err(e) => report(&e, &SourceMap::new()),
         },
         Cmd::Compare(p) => crate::analysis::compare::cli(p.args),

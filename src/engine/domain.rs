@@ -82,13 +82,27 @@ impl Domain {
         }
     }
     /// Wrap a position into the periodic box, updating image counts
-    /// (LAMMPS `Domain::remap`).
+    /// (LAMMPS `Domain::remap`). A coordinate that cannot be wrapped (not
+    /// finite, or so far out that its image count or its offset in the box
+    /// is lost to rounding: `velocity set 1e300` with the guard off looped
+    /// here forever) becomes infinite, so that the lost-atom check after the
+    /// wrap takes the particle (LAMMPS loses such atoms: "Lost atoms").
     pub fn wrap(&self, x: &mut V3, image: &mut [i32; 3]) {
         for d in 0..3 {
             if !self.periodic(d) {
                 continue;
             }
             let l = self.len(d);
+            let periods = ((x[d] - self.lo[d]) / l).floor();
+            if !periods.is_finite() || periods.abs() > 1e9 || (image[d] as f64 + periods).abs() > i32::MAX as f64 {
+                x[d] = if x[d].is_nan() { x[d] } else { f64::INFINITY.copysign(x[d]) };
+                continue;
+            }
+            if periods.abs() > 2.0 {
+                // far out: one step instead of one subtraction per period
+                x[d] -= periods * l;
+                image[d] += periods as i32;
+            }
             while x[d] < self.lo[d] {
                 x[d] += l;
                 image[d] -= 1;
@@ -168,5 +182,21 @@ mod tests {
         assert!((x - V3::new(0.25, 1.5, 2.5)).norm() < 1e-15);
         assert!(!d.outside_fixed(&x));
         assert!(d.outside_fixed(&V3::new(0.5, 2.0, 0.5)));
+    }
+
+    #[test]
+    fn wrap_gives_up_on_what_it_cannot_wrap() {
+        let d = Domain::new([0.0; 3], [0.01; 3], [[Side::Periodic; 2]; 3], 3);
+        let mut im = [0; 3];
+        let mut x = V3::new(1e300, f64::NEG_INFINITY, f64::NAN);
+        d.wrap(&mut x, &mut im);
+        assert_eq!((x.x, x.y), (f64::INFINITY, f64::NEG_INFINITY));
+        assert!(x.z.is_nan());
+        // far but wrappable: one step, and the image count follows
+        let mut x = V3::new(1000.005, -999.995, 0.005);
+        let mut im = [0; 3];
+        d.wrap(&mut x, &mut im);
+        assert_eq!(im, [100000, -100000, 0]);
+        assert!((x - V3::new(0.005, 0.005, 0.005)).norm() < 1e-9, "{x:?}");
     }
 }

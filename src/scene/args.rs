@@ -16,6 +16,10 @@ pub fn parse_f64(w: &Word) -> Result<f64> {
     let t = w.text.trim();
     let ok = !t.is_empty() && t.chars().all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-'));
     match t.parse::<f64>() {
+        // A literal beyond f64 (1e400): LAMMPS 29 Sep 2021 and LIGGGHTS 3.8
+        // take atof's infinity and run on with it (`timestep 1e400`); no
+        // deck means that, so it is refused here
+        Ok(v) if ok && v.is_infinite() => Err(Error::deck(w.span, format!("number '{}' is too large for a double (at most {:e})", w.text, f64::MAX))),
         Ok(v) if ok => Ok(v),
         _ => Err(Error::deck(w.span, format!("expected a number, found '{}'", w.text))),
     }
@@ -65,7 +69,13 @@ impl<'a> Args<'a> {
     /// The next word as a number.
     pub fn f64(&mut self, what: &str) -> Result<f64> {
         let w = self.word(what)?;
-        parse_f64(w).map_err(|e| Error::deck(w.span, format!("{}: {} must be a number, not '{}'", self.cmd.name(), what, w.text)).with_hint(e.message()))
+        parse_f64(w).map_err(|e| {
+            if w.text.trim().parse::<f64>().is_ok_and(f64::is_infinite) {
+                Error::deck(w.span, format!("{}: {what}: {}", self.cmd.name(), e.message()))
+            } else {
+                Error::deck(w.span, format!("{}: {} must be a number, not '{}'", self.cmd.name(), what, w.text)).with_hint(e.message())
+            }
+        })
     }
     /// The next word as an integer.
     pub fn i64(&mut self, what: &str) -> Result<i64> {

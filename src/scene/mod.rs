@@ -467,6 +467,16 @@ impl Session {
                 _ => return Err(Error::deck(k.span, "run ... every is handled by the interpreter; this form is malformed")),
             }
         }
+        // LAMMPS 29 Sep 2021 and LIGGGHTS 3.8 take N (and, with upto, the
+        // steps left) as a 32-bit count: `run 2147483648` or `run -1` stop
+        // there with "Invalid run command N value"
+        let max = i64::from(i32::MAX);
+        if !upto && !(0..=max).contains(&n) {
+            return Err(Error::deck(cmd.args()[0].span, format!("run: N must be between 0 and {max}, not {n}")).with_hint("LAMMPS and LIGGGHTS: Invalid run command N value"));
+        }
+        if upto && n.checked_sub(self.sim.step).is_some_and(|d| d > max) {
+            return Err(Error::deck(cmd.args()[0].span, format!("run upto {n}: {} steps from step {} is more than {max}", n - self.sim.step, self.sim.step)).with_hint("LAMMPS and LIGGGHTS: Invalid run command upto value"));
+        }
         let mut steps = if upto { n - self.sim.step } else { n };
         if let Some(m) = self.max_steps {
             steps = steps.min(m);

@@ -20,7 +20,14 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             if let Some(v) = w.text.strip_prefix("v_") {
                 return Err(Error::unsupported(w.span, format!("thermo v_{v} (variable thermo interval)")));
             }
-            s.sim.thermo.every = super::args::parse_i64(w)?;
+            let every = super::args::parse_i64(w)?;
+            // LAMMPS 29 Sep 2021 and LIGGGHTS 3.8 both stop on `thermo -1`
+            // ("Illegal thermo command"); `thermo 0` (first and last step
+            // only) is theirs too
+            if !(0..=i64::from(i32::MAX)).contains(&every) {
+                return Err(Error::deck(w.span, format!("thermo: N must be between 0 and {}, not {every}", i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Illegal thermo command"));
+            }
+            s.sim.thermo.every = every;
             Ok(())
         }
         "thermo_style" => {
@@ -111,7 +118,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             }
             Ok(())
         }
-        "dump" => dump_command(s, cmd, &mut a),
+        "dump" => dump_command(s, cmd, &mut a, false),
         "write_dump" => write_dump(s, cmd),
         "dump_modify" => {
             let w = a.word("dump id")?;
@@ -508,7 +515,7 @@ fn write_dump(s: &mut Session, cmd: &Command) -> Result<()> {
     words.extend(cols.iter().cloned());
     let dump_cmd = Command { words, span: cmd.span };
     let mut a = Args::new(&dump_cmd);
-    dump_command(s, &dump_cmd, &mut a)?;
+    dump_command(s, &dump_cmd, &mut a, true)?;
     let Some(k) = s.sim.dumps.iter().position(|x| x.id() == "demx_write_dump") else {
         return Ok(());
     };
@@ -522,12 +529,19 @@ fn write_dump(s: &mut Session, cmd: &Command) -> Result<()> {
     Ok(())
 }
 
-fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
+/// `dump ID group style N file ...`; `one_off` for the dump that
+/// `write_dump` makes (N = 0: written once, never due).
+fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args, one_off: bool) -> Result<()> {
     let id = a.word("dump id")?;
     let g = a.word("group")?;
     let group = s.group(g)?;
     let style = a.word("dump style")?;
     let every = a.i64("N")?;
+    // LAMMPS 29 Sep 2021 and LIGGGHTS 3.8 stop on N <= 0 ("Invalid dump
+    // frequency"); demx wrote no file and went on. N is an int there.
+    if !one_off && !(1..=i64::from(i32::MAX)).contains(&every) {
+        return Err(a.err_prev(format!("dump {}: N must be between 1 and {}, not {every}", id.text, i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Invalid dump frequency"));
+    }
     let file = a.word("file")?;
     let engine = if s.sim.dialect == Dialect::Liggghts { Engine::Liggghts } else { Engine::Lammps };
     let (opts, columns) = match style.text.as_str() {

@@ -91,7 +91,13 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             Ok(())
         }
         "neighbor" => {
-            s.sim.neigh.skin = a.f64("skin")?;
+            let skin = a.f64("skin")?;
+            // both engines stop on a negative skin ("Illegal neighbor
+            // command"); demx's bins then grew without bound
+            if skin < 0.0 {
+                return Err(a.err_prev(format!("neighbor: skin must be >= 0, not {skin}")).with_hint("LAMMPS and LIGGGHTS: Illegal neighbor command"));
+            }
+            s.sim.neigh.skin = skin;
             let st = a.word("neighbor style")?;
             match st.text.as_str() {
                 "bin" | "nsq" | "multi" => Ok(()),
@@ -197,9 +203,24 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             if n < 1 {
                 return Err(a.err_prev("create_box: need at least one atom type"));
             }
+            if n > i64::from(i32::MAX) {
+                return Err(a.err_prev(format!("create_box: {n} atom types is more than the engines' limit {}", i32::MAX)));
+            }
+            // the type-pair tables (pair and wall coefficients) hold (N+1)^2
+            // entries: LAMMPS stops at `run` with "Failed to allocate
+            // 80001600008 bytes for array neigh:cutneighsq" for 1e5 types
+            let bytes = 2.0 * ((n + 1) as f64).powi(2) * std::mem::size_of::<crate::physics::PairParams>() as f64;
+            if !crate::limits::fits(bytes) {
+                return Err(a.err_prev(format!("create_box: {n} atom types need {} for the type-pair coefficient tables; {}", crate::limits::human(bytes), crate::limits::machine())));
+            }
             let rw = a.word("region")?;
             let r = region(s, rw)?;
             let (lo, hi) = r.bbox().ok_or_else(|| Error::deck(rw.span, format!("create_box: region '{}' has no finite bounding box", rw.text)))?;
+            // both engines: "Box bounds are invalid or missing"
+            if let Some(d) = (0..3).find(|&d| hi[d].is_nan() || lo[d].is_nan() || hi[d] <= lo[d]) {
+                let axis = ["x", "y", "z"][d];
+                return Err(Error::deck(rw.span, format!("create_box: region '{}' is empty in {axis} ({axis}lo {} >= {axis}hi {})", rw.text, lo[d], hi[d])).with_hint("LAMMPS and LIGGGHTS: Box bounds are invalid or missing"));
+            }
             while a.more() {
                 // LIGGGHTS/LAMMPS extra keywords (bond/types, extra/...): accept numbers
                 a.word("keyword")?;
@@ -301,7 +322,20 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         }
         _ => {
             let n = a.i64("N")?;
+            // LAMMPS 29 Sep 2021 and LIGGGHTS 3.8 read N and the seed as
+            // 32-bit ints and stop on N < 0 or seed <= 0 ("Illegal
+            // create_atoms command"); demx created nothing and went on
+            if !(0..=i64::from(i32::MAX)).contains(&n) {
+                return Err(a.err_prev(format!("create_atoms random: N must be between 0 and {}, not {n}", i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Illegal create_atoms command"));
+            }
+            let bytes = (s.sim.particles.len() as f64 + n as f64) * crate::limits::BYTES_PER_PARTICLE;
+            if !crate::limits::fits(bytes) {
+                return Err(a.err_prev(format!("create_atoms random: {n} particles need at least {}; {}", crate::limits::human(bytes), crate::limits::machine())));
+            }
             let seed = a.i64("seed")?;
+            if !(1..=i64::from(i32::MAX)).contains(&seed) {
+                return Err(a.err_prev(format!("create_atoms random: seed must be between 1 and {}, not {seed}", i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Illegal create_atoms command"));
+            }
             let rw = a.word("region")?;
             if rw.text != "NULL" {
                 region_filter = Some(region(s, rw)?.clone());
@@ -349,6 +383,10 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             .create_points(V3::from(dom.lo), V3::from(dom.hi), periodic, Some(&f))
             .map_err(|e| Error::deck(style.span, e.message()))?;
         points = pts.into_iter().map(|(p, _)| p).collect();
+    }
+    let bytes = (s.sim.particles.len() + points.len()) as f64 * crate::limits::BYTES_PER_PARTICLE;
+    if !crate::limits::fits(bytes) {
+        return Err(Error::deck(style.span, format!("create_atoms: {} particles need at least {}; {}", points.len(), crate::limits::human(bytes), crate::limits::machine())));
     }
     // LAMMPS default diameter 1, density 1 for atom_style sphere
     let mut tag = s.sim.particles.max_tag();
@@ -622,6 +660,20 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         }
         let v = a.word("value")?;
         let val = parse_f64(v)?;
+        // the engines' own limits (LAMMPS 29 Sep 2021 set.cpp, LIGGGHTS 3.8
+        // set.cpp): "Invalid density/diameter/mass in set command", "Invalid
+        // value in set command" for a type outside the box's types
+        let bad = match k.text.as_str() {
+            "density" if val.is_nan() || val <= 0.0 => Some("density must be > 0".to_string()),
+            "diameter" if val.is_nan() || val < 0.0 => Some("diameter must be >= 0".to_string()),
+            "mass" if val.is_nan() || val <= 0.0 => Some("mass must be > 0".to_string()),
+            "type" if val.fract() != 0.0 || val < 1.0 || val > s.sim.ntypes as f64 => Some(format!("type must be an atom type 1..{}", s.sim.ntypes)),
+            _ => None,
+        };
+        if let Some(why) = bad {
+            let what = if k.text == "type" { "value" } else { k.text.as_str() };
+            return Err(Error::deck(v.span, format!("set {}: {why}, not {}", k.text, v.text)).with_hint(format!("LAMMPS and LIGGGHTS: Invalid {what} in set command")));
+        }
         // LAMMPS's `set diameter` keeps the mass ("does not adjust the
         // particle mass", set command doc); LIGGGHTS's keeps the density
         let diameter_keeps_mass = s.dialect_now() == Dialect::Lammps;
