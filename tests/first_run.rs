@@ -30,6 +30,7 @@ boundary f f f
 newton off
 communicate single vel yes
 units si
+hard_particles yes
 region reg block -0.05 0.05 -0.01 0.01 -0.001 0.01 units box
 create_box 1 reg
 neighbor 0.0002 bin
@@ -158,7 +159,7 @@ fn heap_time_step_above_the_measured_fraction_warns() {
     let (ok, out) = run_in(dir.path(), &["check", deck, "-var", "N", "100"]);
     assert!(ok, "{out}");
     assert!(!has_timestep_warning(&out), "{out}");
-    assert!(!out.contains("cohesion"), "{out}");
+    assert!(!out.contains("runs with a Young's modulus"), "{out}");
     // demx run says it too, before the first run (stopped after a step per run)
     let (ok, out) = run_in(dir.path(), &["run", deck, "-var", "dtfrac", "0.2", "-var", "N", "30", "--max-steps", "1"]);
     assert!(ok, "{out}");
@@ -206,8 +207,8 @@ fn repose_warns_on_a_free_cone_and_not_on_a_covered_heap() {
     let dir = tempfile::tempdir().unwrap();
     // 25 deg, 8 d high: base radius 17 d, on a 60 d plate (a free cone)
     cone_dump(&dir.path().join("free.dump"), 25.0, 8, 30.0);
-    // the same cone on a 40 d plate: its slopes run off the edges
-    cone_dump(&dir.path().join("covered.dump"), 25.0, 8, 20.0);
+    // 25 deg, 12 d high (base radius 26 d) on a 40 d plate: its slopes run off the edges
+    cone_dump(&dir.path().join("covered.dump"), 25.0, 12, 20.0);
     let (ok, out) = run_in(dir.path(), &["repose", "free.dump"]);
     assert!(ok, "{out}");
     assert!(out.contains("warning: the heap does not cover the plate") && out.contains("'Heap size'"), "{out}");
@@ -229,7 +230,7 @@ fn repose_warns_on_a_free_cone_and_not_on_a_covered_heap() {
 fn repose_warns_when_the_projections_disagree() {
     let dir = tempfile::tempdir().unwrap();
     // a covered cone stretched along x: steep in the x-z projection, shallow in y-z
-    cone_dump(&dir.path().join("c.dump"), 25.0, 8, 20.0);
+    cone_dump(&dir.path().join("c.dump"), 25.0, 12, 20.0);
     let text = std::fs::read_to_string(dir.path().join("c.dump")).unwrap();
     let mut out = String::new();
     let mut atoms = false;
@@ -267,7 +268,7 @@ fn defaults_give_the_protocols_angle_of_repose_on_a_shortened_heap() {
     // the defaults are the non-cohesive stock model with 5,000 grains
     let (ok, out) = run_in(dir.path(), &["check", deck.to_str().unwrap()]);
     assert!(ok, "{out}");
-    assert!(out.contains("contact: hertz + tangential history") && !out.contains("vdw"), "{out}");
+    assert!(out.contains("contact: hertz (LIGGGHTS) + tangential history") && !out.contains("vdw"), "{out}");
     let text = std::fs::read_to_string(&deck).unwrap();
     assert!(text.contains("variable        N     index 5000 "), "N = 5000 by default");
     let (ok, out) = run_in(dir.path(), &["run", deck.to_str().unwrap(), "-var", "plate", "24", "-var", "N", "1500", "--log", "none", "--quiet"]);
