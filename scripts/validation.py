@@ -31,7 +31,7 @@ CASES = [
     ("templates/drop/in.drop.lammps", "lammps", [], "drop on a wall, trajectories"),
     ("templates/settle/in.settle.liggghts", "liggghts", [], "1,000-sphere settling: trajectories until chaos, then statistics vs a 3-member demx ensemble"),
     ("templates/settle/in.settle.lammps", "lammps", [], "1,000-sphere settling: trajectories until chaos, then statistics vs a 3-member demx ensemble"),
-    ("templates/heap/in.heap", "liggghts", ["--seeds", "3", "--heap", "-var", "model", "stock"],
+    ("templates/heap/in.heap", "liggghts", ["--seeds", "3", "--heap", "-var", "model", "stock", "-var", "N", "2000"],
      "stock heap, d = 1 mm, Y = 1e7 Pa, N = 2000 poured: statistics over 3 seeds each"),
 ]
 

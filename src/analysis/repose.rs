@@ -188,6 +188,72 @@ pub fn repose_profiles(f: &Frame) -> Result<(Repose, Profile, Profile)> {
     Ok((rep, pxz, pyz))
 }
 
+/// `demx repose` warns when the two projections differ by more than this
+/// (degrees). Regular heaps measured in VALIDATION.md's heap-size section
+/// differ by 0-1.4 deg (16.97/15.57, 24.42/24.42, 25.32/26.19, 25.19/26.01)
+/// and 3-seed means of one setting scatter by SD 1.1-1.6 deg (tradeoff
+/// section): twice the largest such difference means an irregular heap.
+pub const PROJECTION_SPREAD_WARN: f64 = 3.0;
+
+/// A side of the plate counts as covered when a sphere centred within
+/// [`EDGE_BAND`] diameters of it reaches this many diameters above the plate
+/// (two layers: a lone grain on the plate reaches one). Measured on the heap
+/// template (1 mm, stock model, 2026-12-07): the free cone of N = 2000 has
+/// only lone grains there (1.0 d on all four edges, θr 15.4 deg); the heaps
+/// of N = 5000 that cover the plate reach 1.80-1.86 d (demx 24.7 deg,
+/// LIGGGHTS 25.1 deg).
+pub const EDGE_COVER_HEIGHT: f64 = 1.5;
+
+/// Width of the band along each plate edge, in mean diameters.
+pub const EDGE_BAND: f64 = 2.0;
+
+/// Warnings on a heap measured by [`repose`]: a heap that does not cover the
+/// plate (a free cone, lower than the protocol's heap), projections that
+/// disagree beyond their usual spread. The plate is the frame's box in x and
+/// y (templates/heap/in.heap: the wall spans the box, and grains that roll
+/// off leave it).
+pub fn heap_warnings(f: &Frame, rep: &Repose) -> Result<Vec<String>> {
+    let mut w = vec![];
+    let [x, y, z] = positions(f)?;
+    let r = radii(f)?;
+    let d = rep.diameter;
+    let plate = z.iter().zip(&r).map(|(a, b)| a - b).fold(f64::INFINITY, f64::min);
+    // highest sphere top near each of the four edges, in diameters
+    let mut tops = [0.0_f64; 4];
+    for k in 0..r.len() {
+        let top = (z[k] + r[k] - plate) / d;
+        let dist = [x[k] - f.bounds.lo[0], f.bounds.hi[0] - x[k], y[k] - f.bounds.lo[1], f.bounds.hi[1] - y[k]];
+        for (e, t) in dist.iter().zip(tops.iter_mut()) {
+            if *e < EDGE_BAND * d && top > *t {
+                *t = top;
+            }
+        }
+    }
+    let names = ["x lo", "x hi", "y lo", "y hi"];
+    let bare: Vec<String> = names.iter().zip(&tops).filter(|(_, &t)| t < EDGE_COVER_HEIGHT).map(|(n, t)| format!("{n} edge: {t:.1} d")).collect();
+    if !bare.is_empty() {
+        w.push(format!(
+            "the heap does not cover the plate (the box's x-y extent, {:.1} x {:.1} d): within {EDGE_BAND} d of an edge no \
+             grain stands {EDGE_COVER_HEIGHT} d above the plate ({}). This is a free cone, lower than the protocol's heap: \
+             without cohesion the 1 mm cone of 2,000 grains measured 16.3 deg against 24.4-25.8 deg for heaps of 5,000-25,000 \
+             that cover the plate (VALIDATION.md, 'Heap size'); pour more grains",
+            (f.bounds.hi[0] - f.bounds.lo[0]) / d,
+            (f.bounds.hi[1] - f.bounds.lo[1]) / d,
+            bare.join(", ")
+        ));
+    }
+    let spread = (rep.theta_xz - rep.theta_yz).abs();
+    if spread > PROJECTION_SPREAD_WARN {
+        w.push(format!(
+            "the two projections differ by {spread:.1} deg (x-z {:.2}, y-z {:.2}), more than {PROJECTION_SPREAD_WARN} deg: \
+             regular heaps differ by 0-1.4 deg (VALIDATION.md, 'Heap size'), so this heap is irregular or not yet \
+             relaxed and its mean is not an angle of repose to trust",
+            rep.theta_xz, rep.theta_yz
+        ));
+    }
+    Ok(w)
+}
+
 /// The `--plot` charts: each side projection with its rasterised upper
 /// boundary and fitted triangle, equal scales.
 pub fn charts(xz: &Profile, yz: &Profile) -> Vec<crate::plot::Chart> {
@@ -307,17 +373,19 @@ pub fn cli(args: Vec<String>) -> ExitCode {
             return ExitCode::from(e.exit_code());
         }
     }
-    let res = pick_frame(&c.dump, c.frame).and_then(|f| repose_profiles(&f)).and_then(|(r, xz, yz)| {
+    let res = pick_frame(&c.dump, c.frame).and_then(|f| {
+        let (r, xz, yz) = repose_profiles(&f)?;
         if let Some(p) = &plot {
             crate::plot::write_png(p, &charts(&xz, &yz))?;
         }
-        Ok(r)
+        let w = heap_warnings(&f, &r)?;
+        Ok((r, w))
     });
     match res {
-        Ok(r) => {
+        Ok((r, warnings)) => {
             let bo = bond_number(c.gamma, r.diameter, c.g, c.rho);
             if c.json {
-                let v = serde_json::json!({"repose": r, "bond_number": bo, "regime": regime(bo)});
+                let v = serde_json::json!({"repose": r, "bond_number": bo, "regime": regime(bo), "warnings": warnings});
                 println!("{v}");
             } else {
                 println!("theta_r = {:.2} +- {:.2} deg (x-z {:.2}, y-z {:.2})", r.theta, r.sd, r.theta_xz, r.theta_yz);
@@ -332,6 +400,9 @@ pub fn cli(args: Vec<String>) -> ExitCode {
                     c.rho,
                     regime(bo)
                 );
+                for w in &warnings {
+                    println!("warning: {w}");
+                }
             }
             ExitCode::SUCCESS
         }

@@ -501,6 +501,16 @@ impl Session {
         }
         // demx run --dt-fraction, when no `timestep` command could apply it
         overrides::before_run(self, cmd.words[0].span)?;
+        // where the physics is known to break: say so once, before the first run
+        if self.schedule.is_empty() && !self.check {
+            for w in summary::physics_warnings(self) {
+                let line = format!("WARNING (demx): {w}");
+                if !self.sim.log.screen {
+                    eprintln!("{line}");
+                }
+                self.sim.log.line(&line);
+            }
+        }
         self.schedule.push(RunRecord { steps, start: self.sim.step, particles: self.sim.particles.len() });
         self.sim.run_bounds = Some((start.unwrap_or(self.sim.step), stop.unwrap_or(self.sim.step + steps)));
         if !self.sim.fixes.iter().any(|f| f.integrates()) && !self.check {

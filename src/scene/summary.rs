@@ -64,6 +64,117 @@ pub struct TimestepCheck {
 /// overlaps degrade quickly).
 pub const TIMESTEP_WARN_FRACTION: f64 = 0.2;
 
+/// demx warns when the time step is above this fraction of the Hertz time:
+/// the heap template's angle of repose was measured
+/// unchanged up to it and shifted above it (VALIDATION.md, "Heap: angle of
+/// repose vs stiffness and time step": 0.1 within 0.5 deg of 0.05, 0.2 1.4
+/// deg low, 0.3 stopped 2 of 3 runs; 3 seeds each, N = 2000, model stock).
+pub const THETA_TIMESTEP_FRACTION: f64 = 0.1;
+
+/// What the heap tradeoff measured above [`THETA_TIMESTEP_FRACTION`].
+pub const THETA_TIMESTEP_EFFECT: &str = "on the heap template, dt = 0.2 of the Hertz time gave an angle of repose 1.4 deg \
+     lower than 0.05 (15.86 against 17.27 deg, 3 seeds each) and 0.3 stopped 2 of 3 runs, while 0.1 stayed within 0.5 deg \
+     (VALIDATION.md, 'Heap: angle of repose vs stiffness and time step')";
+
+/// The lowest Young's modulus (Pa) at which demx's cohesive heaps were
+/// measured to agree with the paper: its own 63 GPa. Every softer value
+/// measured moved the angle of repose by tens of degrees, so there is no
+/// safe softened range to allow (VALIDATION.md, "Cohesive heap: softened
+/// stiffness and the surface energy" and "contact-force or net-force caps").
+pub const COHESIVE_SAFE_YOUNGS: f64 = 6.3e10;
+
+/// What softening a cohesive contact was measured to do.
+pub const COHESIVE_SOFT_EFFECT: &str = "softening a cohesive contact below 63 GPa changed the heap's angle of repose by \
+     tens of degrees: 400 um glass with van der Waals stood at 73.1, 74.0 and 52.6 deg at Y = 1e7, 1e8 and 1e9 Pa against \
+     24.6 deg at 63 GPa (paper Eq. 1: 28.6 deg), 200 um at 43-86 deg against 22-23 deg (VALIDATION.md, 'Cohesive heap: \
+     softened stiffness and the surface energy' and 'contact-force or net-force caps'): the energy that holds a contact \
+     grows as Y^(-2/3). Run cohesive decks at the material's own modulus";
+
+/// Young's modulus and Poisson ratio of type `t` as the contact model sees
+/// them (after `demx run --youngs-scale`); None where the model has none.
+fn youngs_of_type(s: &Session, t: u32) -> Option<(f64, f64)> {
+    use crate::scene::model::NormalSpec;
+    let spec = s.pair.as_ref()?;
+    let per_type = |name: &str, t: u32| s.props.get(name).and_then(|(_, v)| v.get(t as usize - 1).copied());
+    let (y, nu) = match spec.normal {
+        NormalSpec::LigHertz | NormalSpec::LigHooke { .. } | NormalSpec::PaperViscoelastic => {
+            (per_type("youngsModulus", t)?, per_type("poissonsRatio", t)?)
+        }
+        NormalSpec::Granular(..) | NormalSpec::GranularCohesive(..) => {
+            let pp = spec.granular.iter().find(|(i, j, _)| *i == t && *j == t).map(|x| x.2)?;
+            if pp.poisson > 0.0 {
+                // y_eff = E / (2 (1 - nu^2)) for identical materials
+                (pp.y_eff * 2.0 * (1.0 - pp.poisson * pp.poisson), pp.poisson)
+            } else {
+                return None;
+            }
+        }
+        _ => return None,
+    };
+    Some((y / s.overrides.stiffness_divisor(), nu))
+}
+
+/// The cohesion law a scene runs, when some pair of types has a non-zero
+/// surface energy or cohesion energy density: its name and the softest
+/// Young's modulus (Pa) among the cohesive types.
+fn cohesive_youngs(s: &Session) -> Option<(String, f64)> {
+    use crate::scene::model::{CohesionSpec, CohesiveNormal, NormalSpec};
+    let spec = s.pair.as_ref()?;
+    let name = match (spec.normal, &spec.cohesion) {
+        (NormalSpec::GranularCohesive(CohesiveNormal::Jkr, _), _) => "jkr",
+        (NormalSpec::GranularCohesive(CohesiveNormal::Dmt, _), _) => "dmt",
+        (_, CohesionSpec::Vdw { .. }) => "van der Waals (cohesion vdw)",
+        (_, CohesionSpec::Sjkr { .. }) => "sjkr",
+        (_, CohesionSpec::Sjkr2 { .. }) => "sjkr2",
+        _ => return None,
+    };
+    let table = &s.sim.model.as_ref()?.table;
+    let mut y_min: Option<f64> = None;
+    for i in 1..=table.ntypes as u32 {
+        for j in 1..=table.ntypes as u32 {
+            if table.get(i, j).cohesion > 0.0 {
+                for t in [i, j] {
+                    if let Some((y, _)) = youngs_of_type(s, t) {
+                        y_min = Some(y_min.map_or(y, |m: f64| m.min(y)));
+                    }
+                }
+            }
+        }
+    }
+    y_min.map(|y| (name.to_string(), y))
+}
+
+/// Warnings where the physics is known to break, with the measured size of
+/// the effect and where it was measured: a cohesive model with a softened
+/// Young's modulus, a time step above the fraction that shifted the heap's
+/// angle of repose. `demx check` lists them; `demx run` prints them before
+/// the first run, on screen and in the log.
+pub fn physics_warnings(s: &Session) -> Vec<String> {
+    let mut w = vec![];
+    if let Some((name, y)) = cohesive_youngs(s) {
+        if y < COHESIVE_SAFE_YOUNGS * (1.0 - 1e-9) {
+            w.push(format!(
+                "cohesion {name} runs with a Young's modulus of {y:e} Pa, below {COHESIVE_SAFE_YOUNGS:e} Pa, the softest \
+                 modulus at which demx's cohesive heaps were measured to agree with the paper: {COHESIVE_SOFT_EFFECT}"
+            ));
+        }
+    }
+    if let Some(t) = timestep_check(s) {
+        // measured as a fraction of the Hertz time (the deck's dtfrac)
+        if t.fraction_hertz > THETA_TIMESTEP_FRACTION {
+            w.push(format!(
+                "time step {:e} s is {:.0}% of the Hertz time ({:.0}% of the Rayleigh time), above the {:.0}% up to which \
+                 a heap's angle of repose was measured unchanged: {THETA_TIMESTEP_EFFECT}",
+                s.sim.dt,
+                100.0 * t.fraction_hertz,
+                100.0 * t.fraction_rayleigh,
+                100.0 * THETA_TIMESTEP_FRACTION
+            ));
+        }
+    }
+    w
+}
+
 /// The particle sizes and densities the scene holds or will insert, by type.
 fn particle_kinds(s: &Session) -> Vec<(u32, f64, f64)> {
     let mut out = vec![];
@@ -103,29 +214,19 @@ pub fn timestep_check(s: &Session) -> Option<TimestepCheck> {
         .fold(0.0, f64::max);
     let h = s.sim.domain.as_ref().map_or(0.0, |d| d.len(2));
     let v = vmax.max((2.0 * g * h).sqrt()).max(1e-3);
-    let per_type = |name: &str, t: u32| s.props.get(name).and_then(|(_, v)| v.get(t as usize - 1).copied());
     let mut best: Option<TimestepCheck> = None;
     for (t, r, rho) in kinds {
         let (y, nu) = match spec.normal {
-            NormalSpec::LigHertz | NormalSpec::LigHooke { .. } => (per_type("youngsModulus", t)?, per_type("poissonsRatio", t)?),
-            NormalSpec::Granular(..) => {
-                let pp = spec.granular.iter().find(|(i, j, _)| *i == t && *j == t).map(|x| x.2)?;
-                if pp.poisson > 0.0 {
-                    // y_eff = E / (2 (1 - nu^2)) for identical materials
-                    (pp.y_eff * 2.0 * (1.0 - pp.poisson * pp.poisson), pp.poisson)
-                } else {
-                    (0.0, 0.0)
-                }
-            }
+            NormalSpec::LigHertz | NormalSpec::LigHooke { .. } | NormalSpec::PaperViscoelastic => youngs_of_type(s, t)?,
+            NormalSpec::Granular(..) | NormalSpec::GranularCohesive(..) => youngs_of_type(s, t).unwrap_or((0.0, 0.0)),
             NormalSpec::GranHertz => {
                 // Kn = 4/3 E* with E* = Y / (2 (1 - nu^2)); take nu = 0.3
                 let kn = spec.gran.map(|g| g[0])?;
-                (0.75 * kn * 2.0 * (1.0 - 0.09), 0.3)
+                // demx run --youngs-scale divides every stiffness
+                (0.75 * kn * 2.0 * (1.0 - 0.09) / s.overrides.stiffness_divisor(), 0.3)
             }
             _ => (0.0, 0.0),
         };
-        // demx run --youngs-scale divides every stiffness
-        let y = y / s.overrides.stiffness_divisor();
         let m = 4.0 / 3.0 * std::f64::consts::PI * r * r * r * rho;
         let m_eff = 0.5 * m;
         let (tr, th) = if y > 0.0 {
@@ -184,10 +285,10 @@ impl Summary {
             timestep_check: timestep_check(s),
             warnings: vec![],
         }
-        .with_warnings()
+        .with_warnings(physics_warnings(s))
     }
 
-    fn with_warnings(mut self) -> Summary {
+    fn with_warnings(mut self, physics: Vec<String>) -> Summary {
         if let Some(t) = &self.timestep_check {
             if t.fraction_rayleigh > TIMESTEP_WARN_FRACTION || t.fraction_hertz > TIMESTEP_WARN_FRACTION {
                 self.warnings.push(format!(
@@ -199,6 +300,7 @@ impl Summary {
                 ));
             }
         }
+        self.warnings.extend(physics);
         if self.contact.contains("viscoelastic") || self.contact.contains("vdw") || self.contact.contains("paper") {
             self.notes.push("this deck uses demx-only contact models (the paper's): it runs in demx only".into());
         }
