@@ -502,7 +502,7 @@ impl Session {
         // demx run --dt-fraction, when no `timestep` command could apply it
         overrides::before_run(self, cmd.words[0].span)?;
         // where the physics is known to break: say so once, before the first run
-        if self.schedule.is_empty() && !self.check {
+        if self.schedule.is_empty() && !self.check && !self.replaying {
             for w in summary::physics_warnings(self) {
                 let line = format!("WARNING (demx): {w}");
                 if !self.sim.log.screen {
