@@ -94,8 +94,17 @@ struct Saved {
     journal: Vec<Vec<(String, bool)>>,
     sim: RestartState,
     fixes: Vec<(String, String, serde_json::Value)>,
-    dumps: Vec<(String, Option<(PathBuf, u64)>, Option<i64>)>,
+    dumps: Vec<SavedDump>,
     segments: Vec<Segment>,
+}
+
+/// A dump at a checkpoint: its id, its file and length when the resumed run
+/// appends to it, and the step of its last frame.
+#[derive(Serialize, Deserialize)]
+struct SavedDump {
+    id: String,
+    file: Option<(PathBuf, u64)>,
+    last_step: Option<i64>,
 }
 
 /// What a checkpoint resumes: read by [`Checkpoints::load`], used by
@@ -243,10 +252,10 @@ pub fn write(s: &mut Session, saved: &SavedInterpreter) -> Result<bool> {
     let mut dumps = vec![];
     for d in &s.sim.dumps {
         match d.checkpoint_file() {
-            DumpFile::Fresh => dumps.push((d.id().to_string(), None, d.last_step())),
+            DumpFile::Fresh => dumps.push(SavedDump { id: d.id().to_string(), file: None, last_step: d.last_step() }),
             DumpFile::Appended(p) => {
                 let len = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
-                dumps.push((d.id().to_string(), Some((p, len)), d.last_step()));
+                dumps.push(SavedDump { id: d.id().to_string(), file: Some((p, len)), last_step: d.last_step() });
             }
             DumpFile::Unsupported => blocker = blocker.or(Some(format!("dump {}", d.id()))),
         }
@@ -350,7 +359,7 @@ pub fn resume(s: &mut Session, r: Resume) -> Result<SavedInterpreter> {
     if s.sim.dumps.len() != saved.dumps.len() {
         return Err(bad(format!("{} dumps after the replay, {} at the checkpoint", s.sim.dumps.len(), saved.dumps.len())));
     }
-    for (d, (id, file, last)) in s.sim.dumps.iter_mut().zip(&saved.dumps) {
+    for (d, SavedDump { id, file, last_step: last }) in s.sim.dumps.iter_mut().zip(&saved.dumps) {
         if d.id() != id {
             return Err(bad(format!("dump {} where the checkpoint has dump {id}", d.id())));
         }
