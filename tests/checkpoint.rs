@@ -163,6 +163,14 @@ fn a_fix_a_checkpoint_cannot_carry_prevents_checkpoints_not_the_run() {
     assert_eq!(log.matches("no checkpoint at step").count(), 1, "said once: {log}");
     assert!(log.contains("fix av (ave/time)"), "{log}");
     assert!(!dir.path().join("ckpt/checkpoint.json.gz").exists());
+    // asked to stop (DIR/STOP) it still stops, at the next run line, without a checkpoint
+    std::fs::create_dir_all(dir.path().join("ckpt")).unwrap();
+    std::fs::write(dir.path().join("ckpt/STOP"), "").unwrap();
+    let o = demx(dir.path(), &deck, &vars, &["--checkpoint", "ckpt", "--log", "log.demx"]);
+    assert_eq!(o.status.code(), Some(75), "{}", said(&o));
+    let log = std::fs::read_to_string(dir.path().join("log.demx")).unwrap();
+    assert!(log.contains("without a new checkpoint (fix av (ave/time)"), "{log}");
+    assert!(!dir.path().join("ckpt/checkpoint.json.gz").exists());
 }
 
 /// The campaign's packing deck settles in chunks continued without a setup

@@ -204,9 +204,14 @@ impl Checkpoints {
         Ok(Some(Resume { saved }))
     }
 
-    /// Whether a stop was asked for: SIGTERM, or the file `DIR/STOP`.
+    /// Whether a stop was asked for from outside: SIGTERM, or the file `DIR/STOP`.
+    fn stop_requested(&self) -> bool {
+        TERM.load(Ordering::SeqCst) || self.dir.join("STOP").exists()
+    }
+
+    /// [`Checkpoints::stop_requested`], or the tests' stop after K checkpoints.
     fn stop_asked(&self) -> bool {
-        TERM.load(Ordering::SeqCst) || self.dir.join("STOP").exists() || self.stop_after.is_some_and(|k| self.written + 1 >= k)
+        self.stop_requested() || self.stop_after.is_some_and(|k| self.written + 1 >= k)
     }
 
     /// Whether the next `run` line should be preceded by a checkpoint, after
@@ -263,6 +268,15 @@ pub fn write(s: &mut Session, saved: &SavedInterpreter) -> Result<bool> {
     if let Some(what) = blocker {
         let cp = s.checkpoints.as_mut().expect("checked above");
         cp.last = Instant::now();
+        if cp.stop_requested() {
+            // asked to stop: stop, leaving the last checkpoint (if any) to continue from
+            cp.stopped = true;
+            s.sim.log.line(&format!(
+                "demx: stopping at step {} without a new checkpoint ({what} keeps state a checkpoint cannot carry yet); the last checkpoint stays",
+                s.sim.step
+            ));
+            return Ok(true);
+        }
         if !cp.told {
             cp.told = true;
             s.sim.log.line(&format!(
