@@ -346,7 +346,11 @@ fn run_locked(p: &Place, cli: &Cli) -> ExitCode {
         if !stopping && stop_asked(p) {
             stopping = true;
             for (r, _, _) in &running {
-                let _ = std::fs::write(p.run_dir(r).join("ckpt").join("STOP"), "");
+                // the folder exists only from the run's first checkpoint on
+                let ckpt = p.run_dir(r).join("ckpt");
+                if let Err(e) = std::fs::create_dir_all(&ckpt).and_then(|_| std::fs::write(ckpt.join("STOP"), "")) {
+                    eprintln!("campaign: {}: cannot ask it to stop: {e}", r.name);
+                }
             }
             println!("campaign: stopping; each run stops at its next checkpoint");
         }
