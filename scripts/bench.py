@@ -17,6 +17,10 @@ Decks (bench/ and ../shared/bench/chute, as the performance issue lists them):
   e   scaling: the bed tiled from 7,500 to 1,080,000 particles (demx alone)
   f   Debian's meshGran tutorial (LIGGGHTS): spheres streamed into a hopper of
       triangle-mesh walls, its second run cut to 20,000 steps in all
+  g   isotropic compression of 15,625 grains between six moving STL plates
+      (bench/compression: mesh/surface/stress x 6, move/mesh linear, rolling
+      friction; the deck the performance issue found 5x slower), one thread vs
+      one rank and two threads vs `mpirun -np 2`
 The bed is made by bench/in.bed_prepare.liggghts (7,500 spheres settled in a
 20 x 20 mm periodic box) and tiled in x and y.
 """
@@ -42,6 +46,15 @@ def prepare_meshgran():
         raise RuntimeError("in.meshGran: its `run 40000 upto` line was not found")
     with open(os.path.join(d, "in.meshGran"), "w") as f:
         f.write(deck)
+    return d
+
+
+def prepare_compression():
+    """The compression deck and its six plates in target/bench/compression."""
+    d = os.path.join(WORK, "compression")
+    os.makedirs(d, exist_ok=True)
+    shutil.copy(os.path.join(ROOT, "bench", "compression", "in.compression"), d)
+    subprocess.run([sys.executable, os.path.join(ROOT, "bench", "compression", "make_plates.py"), d], check=True)
     return d
 
 
@@ -221,7 +234,7 @@ def own_two(deck, var, reps):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--reps", type=int, default=5)
-    ap.add_argument("--only", default="a,a2,b1,b2,c,d,e,f")
+    ap.add_argument("--only", default="a,a2,b1,b2,c,d,e,f,g")
     ap.add_argument("--quick", action="store_true", help="small beds and few steps (checks the harness)")
     ap.add_argument("--steps", type=int, default=1000, help="steps per bed run (the chute runs twice as many)")
     ap.add_argument("--out", default=os.path.join(ROOT, "BENCHMARKS.md"))
@@ -260,6 +273,13 @@ def main():
         mg = prepare_meshgran()
         rows.append(case("(f) meshGran tutorial, mesh walls + insert/stream, 20,000 steps", os.path.join(mg, "in.meshGran"), "liggghts",
                          dict(nsteps=11000 if a.quick else 20000), 1 if a.quick else min(3, a.reps), cwd=mg))
+    if "g" in only:
+        cd = prepare_compression()
+        deck = os.path.join(cd, "in.compression")
+        var = dict(nsteps=400 if a.quick else 4000)
+        reps = 1 if a.quick else min(3, a.reps)
+        rows.append(case("(g) compression, six moving STL plates, 1 thread / 1 rank", deck, "liggghts", var, reps, cwd=cd))
+        rows.append(case("(g) compression, 2 threads / `mpirun -np 2`", deck, "liggghts", var, reps, threads=2, ranks=2, cwd=cd))
     scaling = []
     if "e" in only:
         for nx, ny in tiles(a.quick):

@@ -306,8 +306,10 @@ fn moving_rotating_region_floor_matches_lmp() {
 }
 
 /// The dump of 9,680 spheres of 2 mm thrown down onto the pyramid mesh
-/// (apex, edges and faces) at 1.5 m/s, 800 steps, with `neigh`.
-fn pyramid_shower(neigh: &str) -> String {
+/// (apex, edges and faces) at 1.5 m/s, 800 steps, with `neigh`; `motion`
+/// (the words after `move/mesh mesh cad`, or empty) moves the pyramid.
+fn pyramid_shower(neigh: &str, motion: &str) -> String {
+    let mover = if motion.is_empty() { String::new() } else { format!("fix mv all move/mesh mesh cad {motion}\n") };
     let tmp = tempfile::tempdir().expect("tempdir");
     let dump = tmp.path().join("dump.shower");
     let deck = format!(
@@ -317,7 +319,7 @@ fn pyramid_shower(neigh: &str) -> String {
          fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
          pair_style gran model hertz tangential history\npair_coeff * *\ntimestep 0.00001\n\
          fix cad all mesh/surface file ${{DIR}}/pyramid.stl type 1\n\
-         fix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
+         fix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n{mover}\
          lattice sc 0.0022\nregion start block -0.0484 0.0484 -0.0484 0.0484 0.0112 0.0222 units box\ncreate_atoms 1 region start\n\
          set group all diameter 0.002 density 2500\nvelocity all set 0.1 0.05 -1.5 units box\n\
          fix 1 all nve/sphere\nfix 2 all gravity 9.81 vector 0.0 0.0 -1.0\nthermo_modify lost ignore norm no\n\
@@ -330,30 +332,53 @@ fn pyramid_shower(neigh: &str) -> String {
     std::fs::read_to_string(&dump).expect("dump")
 }
 
-/// A mesh at rest keeps, per particle, the triangles within reach plus the
-/// skin at the last pair-list build (`WallGranMesh::post_force`); that must
-/// change no bit against searching the mesh's bins every step (`check no`
-/// rebuilds every step, and the cache is then not used), on more than one
-/// chunk of particles.
-#[test]
-fn mesh_triangle_cache_changes_no_bit() {
-    let cached = pyramid_shower("neighbor 0.001 bin\nneigh_modify delay 0");
-    let searched = pyramid_shower("neighbor 0.001 bin\nneigh_modify delay 0 every 1 check no");
+/// The lists of triangles near each particle (`WallGranMesh::post_force`)
+/// must change no bit against lists found afresh at every step (`check
+/// no` rebuilds the pair list, and with it the triangle lists, every
+/// step), on more than one chunk of particles; `motion` moves the mesh.
+fn triangle_lists_change_no_bit(motion: &str) {
+    let cached = pyramid_shower("neighbor 0.001 bin\nneigh_modify delay 0", motion);
+    let searched = pyramid_shower("neighbor 0.001 bin\nneigh_modify delay 0 every 1 check no", motion);
     // many spheres overlap the pyramid in the last frame (their height
     // above its surface, z = 10 mm (1 - max(|x|, |y|) / 50 mm), is below
-    // the radius)
-    let last = cached.rsplit("ITEM: ATOMS").next().unwrap();
-    let touching = last
-        .lines()
-        .skip(1)
-        .filter(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
-            v[3] - 0.001 < 0.01 * (1.0 - v[1].abs().max(v[2].abs()) / 0.05)
-        })
-        .count();
-    assert!(touching > 300, "only {touching} spheres touch the pyramid");
+    // the radius, at rest)
+    if motion.is_empty() {
+        let last = cached.rsplit("ITEM: ATOMS").next().unwrap();
+        let touching = last
+            .lines()
+            .skip(1)
+            .filter(|l| {
+                let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
+                v[3] - 0.001 < 0.01 * (1.0 - v[1].abs().max(v[2].abs()) / 0.05)
+            })
+            .count();
+        assert!(touching > 300, "only {touching} spheres touch the pyramid");
+    }
     if cached != searched {
         let line = cached.lines().zip(searched.lines()).position(|(a, b)| a != b).unwrap_or(0) + 1;
-        panic!("the triangle cache changed the dump from line {line}");
+        panic!("the triangle lists changed the dump from line {line}");
     }
+}
+
+/// A mesh at rest: the lists hold from one pair-list build to the next.
+#[test]
+fn mesh_triangle_lists_change_no_bit() {
+    triangle_lists_change_no_bit("");
+}
+
+/// A mesh rising into the falling spheres at 0.3 m/s: each sphere's
+/// distance in the mesh's frame grows faster than its own motion, and the
+/// lists must be found again before it passes half the skin.
+#[test]
+fn moving_mesh_triangle_lists_change_no_bit() {
+    triangle_lists_change_no_bit("linear 0. 0. 0.3");
+}
+
+/// A pyramid spun about z once in 50 ms: at its rim the mesh moves 0.06 mm
+/// a step, half the skin in 8 steps, so spheres keep straying from their
+/// lists (they search the mesh's bins that step) and the lists are found
+/// again and again.
+#[test]
+fn spinning_mesh_triangle_lists_change_no_bit() {
+    triangle_lists_change_no_bit("rotate origin 0. 0. 0. axis 0. 0. 1. period 0.05");
 }

@@ -23,7 +23,7 @@
 
 use crate::error::{Error, Result};
 use crate::geom::mesh::closest_point_on_triangle;
-use crate::geom::{rotate_about, ContactKind, Mesh, MeshMotion, Triangle, TriangleBins};
+use crate::geom::{rotate_sc, ContactKind, Mesh, MeshMotion, Triangle, TriangleBins};
 use crate::physics::V3;
 use std::sync::{Arc, RwLock};
 
@@ -373,55 +373,72 @@ impl SurfaceMesh {
         self.coplanar.get(a).map(|c| c.binary_search(&(b as u32)).is_ok()).unwrap_or(false)
     }
 
-    /// Time since the motion started (0 without motion).
-    fn tm(&self, time: f64) -> Option<(MeshMotion, f64)> {
-        self.motion.map(|(m, t0)| (m, time - t0))
+    /// The mesh's placement at `time`, its trigonometry done once: the
+    /// functions below are its methods for one point.
+    pub fn pose(&self, time: f64) -> Pose {
+        let motion = match self.motion {
+            None => PoseMotion::Rest,
+            Some((MeshMotion::Linear(v), t0)) => PoseMotion::Linear { shift: v * (time - t0), v },
+            Some((MeshMotion::Rotate { origin, axis, period }, t0)) => {
+                // the angle of `MeshMotion::position`; back is its exact negative
+                let angle = 2.0 * std::f64::consts::PI * (time - t0) / period;
+                PoseMotion::Rotate { origin, axis, fwd: angle.sin_cos(), back: (-angle).sin_cos(), omega: axis * (2.0 * std::f64::consts::PI / period) }
+            }
+        };
+        Pose { motion, moving: self.moving, surface_vel: self.surface_vel }
+    }
+
+    /// The largest distance of a vertex from the axis of the mesh's
+    /// rotation (0 for other motions).
+    pub fn axis_reach(&self) -> f64 {
+        match self.motion {
+            Some((MeshMotion::Rotate { origin, axis, .. }, _)) => self
+                .tris
+                .iter()
+                .flat_map(|t| t.v)
+                .map(|p| {
+                    let d = p - origin;
+                    (d - axis * axis.dot(&d)).norm()
+                })
+                .fold(0.0f64, f64::max),
+            _ => 0.0,
+        }
+    }
+
+    /// An upper bound on how far a world point at most `rho` from the axis
+    /// of rotation moves in the mesh's frame from time `t0` to `t1` (its
+    /// rigid motion over that time, whenever it started: the bound holds
+    /// for a motion added since `t0`). A rotation moves such a point by at
+    /// most rho times the angle.
+    pub fn drift(&self, t0: f64, t1: f64, rho: f64) -> f64 {
+        let dt = (t1 - t0).abs();
+        match self.motion {
+            None => 0.0,
+            Some((MeshMotion::Linear(v), _)) => v.norm() * dt * (1.0 + 1e-9),
+            // a little over, for the rounding of the bound itself
+            Some((MeshMotion::Rotate { period, .. }, _)) => rho * (2.0 * std::f64::consts::PI * dt / period.abs()) * (1.0 + 1e-9),
+        }
     }
 
     /// World point -> reference frame at `time`.
     pub fn to_reference(&self, p: V3, time: f64) -> V3 {
-        match self.tm(time) {
-            None => p,
-            Some((MeshMotion::Linear(v), t)) => p - v * t,
-            Some((MeshMotion::Rotate { origin, axis, period }, t)) => {
-                origin + rotate_about(p - origin, axis, -2.0 * std::f64::consts::PI * t / period)
-            }
-        }
+        self.pose(time).to_reference(p)
     }
 
     /// Reference point -> world at `time`.
     pub fn to_world(&self, p: V3, time: f64) -> V3 {
-        match self.tm(time) {
-            None => p,
-            Some((m, t)) => m.position(p, t),
-        }
+        self.pose(time).to_world(p)
     }
 
     /// Reference direction -> world at `time`.
     pub fn dir_to_world(&self, d: V3, time: f64) -> V3 {
-        match self.tm(time) {
-            Some((MeshMotion::Rotate { axis, period, .. }, t)) => rotate_about(d, axis, 2.0 * std::f64::consts::PI * t / period),
-            _ => d,
-        }
+        self.pose(time).dir_to_world(d)
     }
 
-    /// Velocity of the wall at world point `p` on triangle `tri` (rigid
-    /// motion plus the conveyor velocity projected into the face, keeping
-    /// its magnitude).
+    /// Velocity of the wall at world point `p` on triangle `tri` (see
+    /// [`Pose::wall_velocity`]).
     pub fn wall_velocity(&self, p: V3, tri: usize, time: f64) -> V3 {
-        let mut v = match self.tm(time) {
-            Some((m, t)) if self.moving => m.velocity(p, t),
-            _ => V3::zeros(),
-        };
-        if let Some(sv) = self.surface_vel {
-            let n = self.dir_to_world(self.tris[tri].n, time);
-            let vt = sv - n * n.dot(&sv);
-            let l = vt.norm();
-            if l > 0.0 {
-                v += vt * (sv.norm() / l);
-            }
-        }
-        v
+        self.pose(time).wall_velocity(p, self.tris[tri].n)
     }
 
     /// Normal and shear stress of each triangle at `time` (None unless a
@@ -560,6 +577,72 @@ impl SurfaceMesh {
     }
 }
 
+/// Where a mesh is at one time ([`SurfaceMesh::pose`]): its rigid motion
+/// evaluated once, with the sines and cosines of a rotation, so that a
+/// step's many points pay no trigonometry. Each method gives the bits of
+/// the motion's own formula (`MeshMotion::position`, `velocity`).
+#[derive(Clone, Copy, Debug)]
+pub struct Pose {
+    motion: PoseMotion,
+    moving: bool,
+    surface_vel: Option<V3>,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum PoseMotion {
+    Rest,
+    Linear { shift: V3, v: V3 },
+    Rotate { origin: V3, axis: V3, fwd: (f64, f64), back: (f64, f64), omega: V3 },
+}
+
+impl Pose {
+    /// World point -> reference frame.
+    pub fn to_reference(&self, p: V3) -> V3 {
+        match self.motion {
+            PoseMotion::Rest => p,
+            PoseMotion::Linear { shift, .. } => p - shift,
+            PoseMotion::Rotate { origin, axis, back: (s, c), .. } => origin + rotate_sc(p - origin, axis, s, c),
+        }
+    }
+
+    /// Reference point -> world.
+    pub fn to_world(&self, p: V3) -> V3 {
+        match self.motion {
+            PoseMotion::Rest => p,
+            PoseMotion::Linear { shift, .. } => p + shift,
+            PoseMotion::Rotate { origin, axis, fwd: (s, c), .. } => origin + rotate_sc(p - origin, axis, s, c),
+        }
+    }
+
+    /// Reference direction -> world.
+    pub fn dir_to_world(&self, d: V3) -> V3 {
+        match self.motion {
+            PoseMotion::Rotate { axis, fwd: (s, c), .. } => rotate_sc(d, axis, s, c),
+            _ => d,
+        }
+    }
+
+    /// Velocity of the wall at world point `p` on a triangle of reference
+    /// normal `n`: the rigid motion's (once the mover has made a step) plus
+    /// the conveyor velocity projected into the face, keeping its magnitude.
+    pub fn wall_velocity(&self, p: V3, n: V3) -> V3 {
+        let mut v = match self.motion {
+            PoseMotion::Linear { v, .. } if self.moving => v,
+            PoseMotion::Rotate { origin, omega, .. } if self.moving => omega.cross(&(p - origin)),
+            _ => V3::zeros(),
+        };
+        if let Some(sv) = self.surface_vel {
+            let n = self.dir_to_world(n);
+            let vt = sv - n * n.dot(&sv);
+            let l = vt.norm();
+            if l > 0.0 {
+                v += vt * (sv.norm() / l);
+            }
+        }
+        v
+    }
+}
+
 /// One particle's contact slots for one mesh wall: `MESH_SLOTS` records of
 /// `[triangle id + 1 (0 = empty), history...]`.
 pub struct Slots<'a> {
@@ -585,8 +668,9 @@ pub struct MeshHit {
 /// Resolve all contacts of one particle (centre `p` in the mesh's
 /// reference frame) with the mesh, maintaining its slots with the
 /// LIGGGHTS duplicate rule; `apply(hit, history)` is called for every
-/// contact that produces a force, in increasing triangle order.
-pub fn resolve_particle(mesh: &SurfaceMesh, p: V3, radius: f64, slots: Slots, apply: impl FnMut(&MeshHit, &mut [f64])) -> Result<()> {
+/// contact that produces a force, in increasing triangle order. Returns
+/// how many slots hold a contact afterwards.
+pub fn resolve_particle(mesh: &SurfaceMesh, p: V3, radius: f64, slots: Slots, apply: impl FnMut(&MeshHit, &mut [f64])) -> Result<usize> {
     resolve_among(mesh, mesh.bins.candidates(p, radius), p, radius, slots, apply)
 }
 
@@ -600,7 +684,7 @@ pub fn resolve_among(
     radius: f64,
     slots: Slots,
     mut apply: impl FnMut(&MeshHit, &mut [f64]),
-) -> Result<()> {
+) -> Result<usize> {
     let w = 1 + slots.width;
     let data = slots.data;
     let mut touched = [false; MESH_SLOTS];
@@ -646,7 +730,7 @@ pub fn resolve_among(
             data[k * w..(k + 1) * w].fill(0.0);
         }
     }
-    Ok(())
+    Ok(touched.iter().filter(|&&t| t).count())
 }
 
 #[cfg(test)]

@@ -72,6 +72,12 @@ pub(crate) fn span_of(cmd: &Command, args: &[Word], i: usize) -> Span {
 /// Rotate `v` by `angle` (radians) about the unit axis `axis` (Rodrigues).
 pub fn rotate_about(v: V3, axis: V3, angle: f64) -> V3 {
     let (s, c) = angle.sin_cos();
+    rotate_sc(v, axis, s, c)
+}
+
+/// [`rotate_about`] with the angle's sine and cosine given (Rodrigues'
+/// formula): the same bits, for a rotation applied to many vectors.
+pub fn rotate_sc(v: V3, axis: V3, s: f64, c: f64) -> V3 {
     v * c + axis.cross(&v) * s + axis * (axis.dot(&v) * (1.0 - c))
 }
 

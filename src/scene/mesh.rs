@@ -15,7 +15,7 @@ use super::Session;
 use crate::engine::fix::{Fix, Hook, Local};
 use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::integrate::CHUNK;
-use crate::engine::mesh_surface::{finnie_increment, resolve_among, resolve_particle, MeshHit, SharedMesh, Slots, StressSum, SurfaceMesh, TriStress, Wear, DEFAULT_CURVATURE_COS, MESH_SLOTS};
+use crate::engine::mesh_surface::{finnie_increment, resolve_among, resolve_particle, MeshHit, Pose, SharedMesh, Slots, StressSum, SurfaceMesh, TriStress, Wear, DEFAULT_CURVATURE_COS, MESH_SLOTS};
 use crate::engine::output::Dump;
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
@@ -426,13 +426,28 @@ fn move_mesh(s: &mut Session, cmd: &Command, id: &str, a: &mut Args) -> Result<(
 struct WallMesh {
     mesh: SharedMesh,
     hist_name: String,
-    /// Per particle, the triangles within reach + 5/8 skin of it at pair-list
-    /// build `near_at.0` of mesh epoch `near_at.1` for `near_at.2` particles
-    /// (CSR: particle i's are `near[start[i]..start[i + 1]]`, increasing);
-    /// see `post_force`.
+    /// Per particle, how many of its slots hold a contact (-1: not known
+    /// yet, as for a particle just inserted or read from a restart).
+    used_name: String,
+    /// Per particle, the triangles within reach + 5/8 skin of its centre
+    /// `anchor[i]` (mesh frame) when they were found, at pair-list build
+    /// `near_at.0` of mesh epoch `near_at.1` for `near_at.2` particles (CSR:
+    /// particle i's are `near[start[i]..start[i + 1]]`, increasing); see
+    /// `post_force`.
     near: Vec<u32>,
     start: Vec<u32>,
-    near_at: Option<(u64, u64, usize)>,
+    anchor: Vec<V3>,
+    /// The particles to visit, chunk by chunk (CSR over chunks of `CHUNK`:
+    /// chunk c's are `active[active_start[c]..active_start[c + 1]]`).
+    active: Vec<u32>,
+    active_start: Vec<u32>,
+    /// The lists' key: pair-list build, mesh epoch, particle count, and
+    /// whether every step checks for a build.
+    near_at: Option<(u64, u64, usize, bool)>,
+    /// When the lists were found, and how far from the axis of the mesh's
+    /// rotation a particle within reach of it can be (for
+    /// [`SurfaceMesh::drift`]).
+    built: Option<(f64, f64)>,
 }
 
 /// LIGGGHTS `fix wall/gran ... mesh n_meshes N meshes ...`.
@@ -463,20 +478,36 @@ impl Fix for WallGranMesh {
     fn setup(&mut self, sim: &mut Sim) -> Result<()> {
         for m in &self.meshes {
             sim.particles.add_extra(&m.hist_name, vec![0.0; self.slot_len()]);
+            sim.particles.add_extra(&m.used_name, vec![-1.0]);
         }
         Ok(())
     }
-    /// Between pair-list builds no particle moves more than half the skin
-    /// when every step checks for a build (delay 0, every 1, check yes), as
-    /// for primitive walls: then a mesh at rest needs, per particle, only
-    /// the triangles that can come within reach of it before the next
-    /// build (those within reach + 5/8 of the skin at the build), found once per
-    /// build (LIGGGHTS keeps such a list too, `fix neighlist/mesh`). A
-    /// moving mesh, or a run checking less often, searches the mesh's bins
-    /// every step. Either way the triangles are tried in increasing index,
-    /// and those left out touch nothing, so the bits are the same.
-    /// Particles run in fixed chunks, in parallel from two chunks up: each
-    /// touches only its own force, torque and slots.
+    /// Each particle meets, in increasing index, the triangles that can
+    /// touch it; those left out touch nothing, so any superset gives the
+    /// same bits. LIGGGHTS keeps such a list per particle (`fix
+    /// neighlist/mesh`), and so does demx: the triangles within reach + 5/8
+    /// of the skin + M of an anchor, the particle's centre in the mesh's own
+    /// frame when the lists were found, where M is the mesh's own allowance
+    /// (half the skin; 0 for a mesh at rest). A triangle at distance D from
+    /// the anchor is at least D - m from a centre m away from it, so a list
+    /// holds every triangle within reach while m stays under half the skin
+    /// + M; each step checks that per particle, and a particle past it
+    /// searches the mesh's bins that step, and the lists are found again at
+    /// the next. (The eighth of the skin left over, and a relative 1e-9 of
+    /// the radius, cover the rounding of the distances.) The lists are found
+    /// again at each pair-list build (particles may be reordered there),
+    /// when the mesh changes, and when the mesh has moved (`move/mesh`,
+    /// rigid) by M since.
+    ///
+    /// When every step checks for a pair-list build (delay 0, every 1, check
+    /// yes), no particle is more than half the skin from where it was at the
+    /// last build: the anchors are those places, seen from the mesh, and m
+    /// stays under half the skin + M without a look. Then only the particles
+    /// with triangles in their lists, or a contact to end, are visited at
+    /// all: a pile far from the walls costs them nothing. Particles run in
+    /// fixed chunks, in parallel from two chunks up: each touches only its
+    /// own force, torque and slots, and the pushes on the mesh are summed in
+    /// particle order within a chunk and in chunk order between them.
     fn post_force(&mut self, sim: &mut Sim, _vars: &Variables) -> Result<()> {
         let len = self.slot_len();
         let time = sim.time;
@@ -484,81 +515,114 @@ impl Fix for WallGranMesh {
         let setup = sim.setup_pass;
         let dt = if setup { 0.0 } else { sim.dt };
         let ns = &sim.neigh;
-        let steady = sim.pairs.x_built.len() == sim.particles.len() && ns.check && ns.delay == 0 && ns.every <= 1;
+        let n = sim.particles.len();
+        let steady = sim.pairs.x_built.len() == n && ns.check && ns.delay == 0 && ns.every <= 1;
         let (builds, skin) = (sim.pairs.builds, ns.skin);
+        let x_built = &sim.pairs.x_built;
         let (group, width, kernel, table) = (self.group, self.width, &*self.kernel, &self.table);
         for wm in &mut self.meshes {
             let col = sim.particles.add_extra(&wm.hist_name, vec![0.0; len]);
+            let ucol = sim.particles.add_extra(&wm.used_name, vec![-1.0]);
             let guard = wm.mesh.read().map_err(|_| lock_err())?;
             let mesh = &*guard;
-            let bounded = steady && mesh.motion.is_none();
+            let pose = mesh.pose(time);
+            let bounded = skin > 0.0;
+            let allowance = if mesh.motion.is_some() { 0.5 * skin } else { 0.0 };
+            let reach_skin = 0.625 * skin + allowance;
+            let bound = 0.5 * skin + allowance;
+            let bound2 = bound * bound;
             let crate::engine::particles::Particles { x, v, omega, f, torque, radius, mass, kind, mask, extra, .. } = &mut sim.particles;
             let (x, v, omega, radius, mass, kind, mask) = (&*x, &*v, &*omega, &*radius, &*mass, &*kind, &*mask);
-            let n = f.len();
+            let key = (builds, mesh.epoch, n, steady);
+            let moved = |wm: &WallMesh| wm.built.is_some_and(|(t0, far)| mesh.drift(t0, time, far) > allowance);
             if !bounded {
                 wm.near_at = None;
-            } else if wm.near_at != Some((builds, mesh.epoch, n)) {
-                // a triangle at distance D from a particle at the build stays
-                // beyond D - skin/2 until the next build, and touches only
-                // below the radius: D < r + skin/2 keeps every one that can
-                // touch; a quarter of that more, and a relative 1e-9 of the
-                // radius, cover the rounding of the distances
-                let reach_skin = 0.625 * skin;
-                let find = |lo: usize, hi: usize| -> (Vec<u32>, Vec<u32>) {
-                    let (mut tris, mut counts) = (vec![], Vec::with_capacity(hi - lo));
+            } else if wm.near_at != Some(key) || moved(wm) {
+                let used = &extra[ucol].data;
+                let find = |lo: usize, hi: usize| -> (Vec<u32>, Vec<u32>, Vec<V3>, Vec<u32>) {
+                    let (mut tris, mut counts, mut anchors, mut active) = (vec![], Vec::with_capacity(hi - lo), Vec::with_capacity(hi - lo), vec![]);
                     for i in lo..hi {
                         let before = tris.len();
+                        let pref = pose.to_reference(if steady { x_built[i] } else { x[i] });
                         if mask[i] & group != 0 {
-                            tris.extend(mesh.near(x[i], radius[i] * (1.0 + 1e-9) + reach_skin).map(|t| t as u32));
+                            tris.extend(mesh.near(pref, radius[i] * (1.0 + 1e-9) + reach_skin).map(|t| t as u32));
+                            if !steady || tris.len() > before || used[i] != 0.0 {
+                                active.push(i as u32);
+                            }
                         }
                         counts.push((tris.len() - before) as u32);
+                        anchors.push(pref);
                     }
-                    (tris, counts)
+                    (tris, counts, anchors, active)
                 };
-                let parts: Vec<(Vec<u32>, Vec<u32>)> = if n >= 2 * CHUNK {
+                let parts: Vec<(Vec<u32>, Vec<u32>, Vec<V3>, Vec<u32>)> = if n >= 2 * CHUNK {
                     (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| find(c * CHUNK, ((c + 1) * CHUNK).min(n))).collect()
                 } else {
-                    vec![find(0, n)]
+                    (0..n.div_ceil(CHUNK).max(1)).map(|c| find(c * CHUNK, ((c + 1) * CHUNK).min(n))).collect()
                 };
                 wm.near.clear();
                 wm.start.clear();
+                wm.anchor.clear();
+                wm.active.clear();
+                wm.active_start.clear();
                 wm.start.push(0);
-                for (tris, counts) in parts {
+                wm.active_start.push(0);
+                for (tris, counts, anchors, active) in parts {
                     wm.near.extend(tris);
                     for c in counts {
                         wm.start.push(wm.start.last().copied().unwrap_or(0) + c);
                     }
+                    wm.anchor.extend(anchors);
+                    wm.active.extend(active);
+                    wm.active_start.push(wm.active.len() as u32);
                 }
-                wm.near_at = Some((builds, mesh.epoch, n));
+                // how far from the mesh's axis a particle within reach can be
+                // (a particle farther out stays farther out: a rotation keeps
+                // its distance from the axis, and it moves under half a skin)
+                let far = mesh.axis_reach() + radius.iter().fold(0.0f64, |m, &r| m.max(r)) + reach_skin + skin;
+                wm.near_at = Some(key);
+                wm.built = Some((time, far));
             }
-            let (near, start) = (&wm.near[..], &wm.start[..]);
+            let (near, start, anchor, active, active_start) = (&wm.near[..], &wm.start[..], &wm.anchor[..], &wm.active[..], &wm.active_start[..]);
             // mesh/surface/stress: the grains of its group push the mesh
             // back; its reference point where the mesh is now
-            let stress = mesh.stress.as_ref().map(|st| (st.group, mesh.to_world(st.p_ref, time)));
+            let stress = mesh.stress.as_ref().map(|st| (st.group, pose.to_world(st.p_ref)));
             // the push on each triangle too, where a dump reads it
             let per_tri = mesh.stress.as_ref().is_some_and(|st| st.per_tri.is_some());
             let wear = mesh.stress.as_ref().and_then(|st| st.wear.as_ref());
             let step_dt = sim.dt;
             // each chunk's push on the mesh (and its triangles), summed in
             // chunk order below: the same bits on any thread count
-            let body = |(c, ((fc, tc), hc)): (usize, ((&mut [V3], &mut [V3]), &mut [f64]))| -> Result<ChunkPush> {
-                let (mut push, mut moment, mut tri_push, mut tri_wear) = (V3::zeros(), V3::zeros(), Vec::new(), Vec::new());
-                for q in 0..fc.len() {
-                    let i = c * CHUNK + q;
-                    if mask[i] & group == 0 {
+            let body = |(c, (((fc, tc), hc), uc)): (usize, (((&mut [V3], &mut [V3]), &mut [f64]), &mut [f64]))| -> Result<ChunkPush> {
+                let (mut push, mut moment, mut tri_push, mut tri_wear, mut strayed) = (V3::zeros(), V3::zeros(), Vec::new(), Vec::new(), false);
+                // the chunk's particles to visit (all of them without lists)
+                let all = c * CHUNK..c * CHUNK + fc.len();
+                let visit: Box<dyn Iterator<Item = usize>> = if bounded {
+                    Box::new(active[active_start[c] as usize..active_start[c + 1] as usize].iter().map(|&i| i as usize))
+                } else {
+                    Box::new(all.filter(|&i| mask[i] & group != 0))
+                };
+                for i in visit {
+                    let q = i - c * CHUNK;
+                    let (xi, ri, vi, wi, mi) = (x[i], radius[i], v[i], omega[i], mass[i]);
+                    let pref = pose.to_reference(xi);
+                    let listed = bounded && (pref - anchor[i]).norm_squared() < bound2;
+                    let cands = if listed { &near[start[i] as usize..start[i + 1] as usize] } else { &[][..] };
+                    // no triangle within reach and no contact to end (its
+                    // slots are empty: `used` counts them, -1 = not known
+                    // yet): nothing would change, so nothing is read
+                    if listed && cands.is_empty() && uc[q] == 0.0 {
                         continue;
                     }
-                    let (xi, ri, vi, wi, mi) = (x[i], radius[i], v[i], omega[i], mass[i]);
-                    let pref = mesh.to_reference(xi, time);
                     let pp = table.get(kind[i], mesh.wall_type);
                     let (mut fs, mut ts) = (V3::zeros(), V3::zeros());
                     let pushes = stress.filter(|&(g, _)| mask[i] & g != 0).map(|(_, at)| at);
                     let wears = wear.filter(|w| mask[i] & w.group != 0).map(|w| w.k[kind[i] as usize - 1]);
                     let slots = Slots { data: &mut hc[q * len..(q + 1) * len], width };
                     let apply = |hit: &MeshHit, hist: &mut [f64]| {
-                        let nrm = mesh.dir_to_world(hit.normal, time);
-                        let point = mesh.to_world(hit.point, time);
-                        let vwall = mesh.wall_velocity(point, hit.tri, time);
+                        let nrm = pose.dir_to_world(hit.normal);
+                        let point = pose.to_world(hit.point);
+                        let vwall = pose.wall_velocity(point, mesh.tris[hit.tri].n);
                         let vr = vi - vwall;
                         let c = Contact::with_wall(nrm, ri - hit.delta, hit.delta, ri, ri, mi, vr, wi, dt);
                         let out = kernel.contact(&c, pp, hist);
@@ -575,33 +639,44 @@ impl Fix for WallGranMesh {
                         }
                         if let Some(k) = wears {
                             let t = &mesh.tris[hit.tri];
-                            let n = mesh.dir_to_world(t.n, time);
+                            let n = pose.dir_to_world(t.n);
                             tri_wear.push((hit.tri as u32, finnie_increment(point - xi, vr, n, k, fi.norm(), step_dt, t.area())));
                         }
                     };
-                    if bounded {
-                        let cands = near[start[i] as usize..start[i + 1] as usize].iter().map(|&t| t as usize);
-                        resolve_among(mesh, cands, pref, ri, slots, apply)?;
+                    let in_use = if listed {
+                        resolve_among(mesh, cands.iter().map(|&t| t as usize), pref, ri, slots, apply)?
                     } else {
-                        resolve_particle(mesh, pref, ri, slots, apply)?;
-                    }
+                        strayed |= bounded;
+                        resolve_particle(mesh, pref, ri, slots, apply)?
+                    };
+                    uc[q] = in_use as f64;
                     fc[q] += fs;
                     tc[q] += ts;
                 }
-                Ok((push, moment, tri_push, tri_wear))
+                Ok((push, moment, tri_push, tri_wear, strayed))
             };
-            let data = &mut extra[col].data[..n * len];
+            let (data, used) = two_columns(extra, col, ucol);
+            let (data, used) = (&mut data[..n * len], &mut used[..n]);
             let done: Vec<Result<ChunkPush>> = if n >= 2 * CHUNK {
-                f.par_chunks_mut(CHUNK).zip(torque.par_chunks_mut(CHUNK)).zip(data.par_chunks_mut(CHUNK * len)).enumerate().map(body).collect()
+                f.par_chunks_mut(CHUNK)
+                    .zip(torque.par_chunks_mut(CHUNK))
+                    .zip(data.par_chunks_mut(CHUNK * len))
+                    .zip(used.par_chunks_mut(CHUNK))
+                    .enumerate()
+                    .map(body)
+                    .collect()
             } else {
-                f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * len)).enumerate().map(body).collect()
+                f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * len)).zip(used.chunks_mut(CHUNK)).enumerate().map(body).collect()
             };
             let parts = done.into_iter().collect::<Result<Vec<ChunkPush>>>()?;
+            if parts.iter().any(|p| p.4) {
+                wm.near_at = None;
+            }
             if stress.is_some() {
                 drop(guard);
                 let mut m = wm.mesh.write().map_err(|_| lock_err())?;
                 if let Some(st) = m.stress.as_mut() {
-                    for (push, moment, tri_push, tri_wear) in parts {
+                    for (push, moment, tri_push, tri_wear, _) in parts {
                         st.force += push;
                         st.torque += moment;
                         if let Some(ts) = st.per_tri.as_mut() {
@@ -632,25 +707,46 @@ impl Fix for WallGranMesh {
         self.summary.clone()
     }
     fn max_surface_overlap(&self, sim: &Sim) -> Option<(usize, f64)> {
-        crate::engine::fix::deepest_overlap(sim, self.group, |i| self.surface_overlap(sim, i))
+        // each mesh placed once for all particles
+        let guards: Vec<_> = self.meshes.iter().filter_map(|wm| wm.mesh.read().ok()).collect();
+        let placed: Vec<(&SurfaceMesh, Pose)> = guards.iter().map(|m| (&**m, m.pose(sim.time))).collect();
+        let p = &sim.particles;
+        crate::engine::fix::deepest_overlap(sim, self.group, |i| deepest_triangle_overlap(&placed, p.x[i], p.radius[i]))
     }
     fn surface_overlap(&self, sim: &Sim, i: usize) -> Option<f64> {
-        // the deepest triangle contact, read only (no history slots touched)
-        let p = &sim.particles;
-        let mut deepest: Option<f64> = None;
-        for wm in &self.meshes {
-            let Ok(mesh) = wm.mesh.read() else { continue };
-            let pref = mesh.to_reference(p.x[i], sim.time);
-            for t in mesh.bins.candidates(pref, p.radius[i]) {
-                if let Some((delta, _, _)) = mesh.triangle_contact(t, pref, p.radius[i]) {
-                    if delta > 0.0 && deepest.is_none_or(|d| delta > d) {
-                        deepest = Some(delta);
-                    }
+        let guards: Vec<_> = self.meshes.iter().filter_map(|wm| wm.mesh.read().ok()).collect();
+        let placed: Vec<(&SurfaceMesh, Pose)> = guards.iter().map(|m| (&**m, m.pose(sim.time))).collect();
+        deepest_triangle_overlap(&placed, sim.particles.x[i], sim.particles.radius[i])
+    }
+}
+
+/// Two different per-atom columns, both writable.
+fn two_columns(extra: &mut [crate::engine::particles::PerAtom], a: usize, b: usize) -> (&mut [f64], &mut [f64]) {
+    assert_ne!(a, b, "two_columns: the same column twice");
+    if a < b {
+        let (lo, hi) = extra.split_at_mut(b);
+        (&mut lo[a].data, &mut hi[0].data)
+    } else {
+        let (lo, hi) = extra.split_at_mut(a);
+        (&mut hi[0].data, &mut lo[b].data)
+    }
+}
+
+/// The deepest triangle contact of a sphere (centre `x`, world) with the
+/// meshes, each at its pose, read only (no history slots touched).
+fn deepest_triangle_overlap(placed: &[(&SurfaceMesh, Pose)], x: V3, r: f64) -> Option<f64> {
+    let mut deepest: Option<f64> = None;
+    for (mesh, pose) in placed {
+        let pref = pose.to_reference(x);
+        for t in mesh.bins.candidates(pref, r) {
+            if let Some((delta, _, _)) = mesh.triangle_contact(t, pref, r) {
+                if delta > 0.0 && deepest.is_none_or(|d| delta > d) {
+                    deepest = Some(delta);
                 }
             }
         }
-        deepest
     }
+    deepest
 }
 
 fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args) -> Result<()> {
@@ -676,7 +772,9 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
     for _ in 0..n {
         let w = a.word("mesh id")?;
         let m = need_mesh(s, w)?;
-        meshes.push(WallMesh { mesh: m, hist_name: format!("mesh_history:{id}:{}", w.text), near: vec![], start: vec![], near_at: None });
+        let hist_name = format!("mesh_history:{id}:{}", w.text);
+        let used_name = format!("{hist_name}:used");
+        meshes.push(WallMesh { mesh: m, hist_name, used_name, near: vec![], start: vec![], anchor: vec![], active: vec![], active_start: vec![], near_at: None, built: None });
         names.push(w.text.clone());
     }
     while a.more() {
@@ -920,8 +1018,9 @@ fn wall_gran_region(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mu
 
 /// What one chunk of grains pushes a mesh with: force, its moment about
 /// the reference point, the push on each triangle touched and the wear of
-/// each, in contact order (when kept).
-type ChunkPush = (V3, V3, Vec<(u32, V3)>, Vec<(u32, f64)>);
+/// each, in contact order (when kept); and whether a grain strayed beyond
+/// its triangle list's bound.
+type ChunkPush = (V3, V3, Vec<(u32, V3)>, Vec<(u32, f64)>, bool);
 
 // ------------------------------------------------------------ dump mesh/stl
 
