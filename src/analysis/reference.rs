@@ -218,6 +218,16 @@ pub fn prepare_deck(deck: &Path, engine: RefEngine, allow_shell: bool) -> Result
     Ok(PreparedDeck { deck_name, text, files, notes })
 }
 
+/// Whether `shell ...` (the whole command) is one of the file operations
+/// the engines run themselves, without a system shell (`mkdir`, `rm`,
+/// `rmdir`, `mv`), on names inside the folder where the deck runs: no
+/// absolute path, no `..`, no variable.
+fn engine_file_operation(command: &str) -> bool {
+    let mut w = command.split_whitespace().skip(1);
+    let op = w.next().unwrap_or("");
+    ["mkdir", "rm", "rmdir", "mv"].contains(&op) && w.all(|a| !a.starts_with('/') && !a.contains("..") && !a.contains('$') && !a.contains('~'))
+}
+
 /// `path:line:col: error:` for the first command in `text` that would run a
 /// system command or Python in the engine: a line whose command (or a quoted
 /// command of `if`/`run every`) is `shell` or starts with `python`, or that
@@ -240,9 +250,10 @@ fn refuse_system_commands(path: &Path, text: &str, engine: RefEngine) -> Result<
         let ws = words(&line);
         let runs = |w: &str| {
             let cmd = w.split_whitespace().next().unwrap_or("");
-            cmd == "shell" || cmd.starts_with("python")
+            (cmd == "shell" && !engine_file_operation(w)) || cmd.starts_with("python")
         };
-        let hit = ws.first().is_some_and(|w| runs(w))
+        let whole = ws.join(" ");
+        let hit = ws.first().is_some_and(|w| if w == "shell" { runs(&whole) } else { runs(w) })
             || ws.iter().skip(1).any(|w| w == "python" || w.starts_with("python/") || (w.contains(' ') && runs(w)));
         if hit {
             let what = ws.iter().find(|w| w.split_whitespace().next().is_some_and(|c| c == "shell" || c.starts_with("python"))).cloned().unwrap_or_default();

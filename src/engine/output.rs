@@ -125,6 +125,9 @@ pub struct Thermo {
     pub every: i64,
     /// Keywords.
     pub keywords: Vec<String>,
+    /// The style is `one` (also by default): the columns are the dialect's
+    /// ([`one_style`]), settled when a run starts.
+    pub one: bool,
     /// Lost-atom policy.
     pub lost: LostPolicy,
     /// Normalise extensive quantities by atom count.
@@ -144,11 +147,24 @@ pub struct Thermo {
     pub dialect: Dialect,
 }
 
+/// The columns of `thermo_style one`, each engine's default: LAMMPS's
+/// `Step Temp E_pair E_mol TotEng Press`, LIGGGHTS 3.8's `Step Atoms KinEng
+/// CPU` (its thermo.cpp defines "one" as `step atoms ke cpu`; checked by
+/// running a deck without thermo_style).
+pub fn one_style(d: Dialect) -> Vec<String> {
+    let ks: &[&str] = match d {
+        Dialect::Lammps => &["step", "temp", "epair", "emol", "etotal", "press"],
+        Dialect::Liggghts => &["step", "atoms", "ke", "cpu"],
+    };
+    ks.iter().map(|k| k.to_string()).collect()
+}
+
 impl Default for Thermo {
     fn default() -> Self {
         Thermo {
             every: 0,
-            keywords: ["step", "temp", "epair", "emol", "etotal", "press"].iter().map(|s| s.to_string()).collect(),
+            keywords: one_style(Dialect::Lammps),
+            one: true,
             lost: LostPolicy::Error,
             norm: false,
             norm_set: false,

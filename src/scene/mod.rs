@@ -19,6 +19,8 @@ pub mod heat;
 pub mod overrides;
 pub mod velocity;
 pub mod checkpoint;
+pub mod commands;
+pub mod shell;
 
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{did_you_mean, Error, Result};
@@ -112,56 +114,6 @@ pub struct Session {
     pub replaying: bool,
 }
 
-/// Commands that only tune MPI, communication or memory: accepted, recorded,
-/// changing nothing in demx.
-const NOOP_COMMANDS: &[&str] = &[
-    "processors",
-    "communicate",
-    "comm_modify",
-    "comm_style",
-    "newton",
-    "partition",
-    "package",
-    "suffix",
-    "balance",
-    "neigh_modify_noop",
-    "sort",
-    "timer",
-    "kspace_style",
-    "special_bonds",
-    "thermo_log",
-    "modify_timing",
-];
-
-/// Commands LAMMPS/LIGGGHTS know and demx does not yet (exit 3, naming them).
-const KNOWN_UNSUPPORTED: &[&str] = &[
-    "minimize",
-    "min_style",
-    "min_modify",
-    "rerun",
-    "read_dump",
-    "write_dump",
-    "replicate",
-    "create_bonds",
-    "bond_style",
-    "bond_coeff",
-    "angle_style",
-    "angle_coeff",
-    "molecule",
-    "kspace_modify",
-    "python",
-    "shell",
-    "fix_modify",
-    "region_modify",
-    "info",
-    "clear",
-    "write_coeff",
-    "pair_modify",
-    "run_style",
-    "reset_atom_ids",
-    "delete_bonds",
-];
-
 impl Session {
     /// A session; `check` = validate only.
     pub fn new(check: bool) -> Session {
@@ -242,7 +194,7 @@ impl Session {
 
     /// `atom_modify keyword value ...`: `sort Nfreq binsize` sets the spatial
     /// sort (0 switches it off); `map`, `first`, `id` change nothing here.
-    fn atom_modify(&mut self, cmd: &Command) -> Result<()> {
+    fn atom_modify(&mut self, cmd: &Command, _vars: &mut Variables) -> Result<()> {
         let mut a = Args::new(cmd);
         while a.more() {
             let k = a.word("keyword")?;
@@ -267,29 +219,10 @@ impl Session {
 
     fn dispatch(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
         let name = cmd.name();
-        match name {
-            "units" | "atom_style" | "boundary" | "dimension" | "neighbor" | "neigh_modify" | "timestep" | "hard_particles"
-            | "soft_particles" | "region" | "create_box" | "lattice" | "create_atoms" | "group" | "set"
-            | "velocity" | "delete_atoms" | "displace_atoms" | "reset_timestep" | "mass" | "change_box" => {
-                setup::execute(self, cmd, vars)?;
-                // demx run --dt-fraction: replaces the deck's time step
-                if name == "timestep" {
-                    overrides::after_timestep(self);
-                }
-                Ok(())
-            }
-            "write_data" | "write_restart" | "read_restart" | "read_data" | "restart" => restart::execute(self, cmd, vars),
-            "pair_style" | "pair_coeff" => model::execute(self, cmd),
-            "fix" | "unfix" => self.fix_command(cmd, vars),
-            "thermo" | "thermo_style" | "thermo_modify" | "dump" | "write_dump" | "dump_modify" | "undump" | "compute" | "uncompute" => {
-                outputs::execute(self, cmd, vars)
-            }
-            "run" => self.run_command(cmd, vars),
-            "atom_modify" => self.atom_modify(cmd),
-            "demx_guard" => self.guard_command(cmd),
-            "compute_modify" => self.compute_modify(cmd),
-            n if NOOP_COMMANDS.contains(&n) => {
-                if n == "newton" {
+        match commands::find(name).map(|c| c.kind) {
+            Some(commands::Kind::Scene(run)) => run(self, cmd, vars),
+            Some(commands::Kind::Noop) => {
+                if name == "newton" {
                     let a = Args::new(cmd);
                     if let Some(w) = a.peek() {
                         if !["on", "off"].contains(&w.text.as_str()) {
@@ -297,18 +230,45 @@ impl Session {
                         }
                     }
                 }
-                self.notes.push((cmd.span, format!("{n}: accepted; changes nothing in demx (single process, deterministic threads)")));
+                self.notes.push((cmd.span, format!("{name}: accepted; changes nothing in demx (single process, deterministic threads)")));
                 Ok(())
             }
-            n if KNOWN_UNSUPPORTED.contains(&n) => Err(Error::unsupported(cmd.words[0].span, format!("command '{n}'"))),
-            _ => {
-                let known: Vec<&str> = ALL_COMMANDS.to_vec();
+            Some(commands::Kind::Unsupported) => Err(Error::unsupported(cmd.words[0].span, format!("command '{name}'"))),
+            // the interpreter runs these itself; one that reaches the scene
+            // came from a replay list or an `if` body, where it is the deck's own error
+            Some(commands::Kind::Script) => Err(Error::deck(cmd.words[0].span, format!("'{name}' is a script command and cannot appear here"))),
+            None => {
                 let mut e = Error::deck(cmd.words[0].span, format!("unknown command '{name}'"));
-                if let Some(s) = did_you_mean(name, known) {
+                if let Some(s) = did_you_mean(name, commands::COMMANDS.iter().map(|c| c.name)) {
                     e = e.with_hint(format!("did you mean '{s}'?"));
                 }
                 Err(e)
             }
+        }
+    }
+
+    /// `timestep dt`; `demx run --dt-fraction` replaces the deck's value.
+    fn timestep_command(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
+        setup::execute(self, cmd, vars)?;
+        overrides::after_timestep(self);
+        Ok(())
+    }
+
+    /// `run_style verlet` (LAMMPS and LIGGGHTS: the velocity-Verlet
+    /// integrator, their default and demx's only one); `respa` and the
+    /// others are not supported.
+    fn run_style(&mut self, cmd: &Command, _vars: &mut Variables) -> Result<()> {
+        let mut a = Args::new(cmd);
+        let w = a.word("run style")?;
+        match w.text.as_str() {
+            "verlet" => {
+                if let Some(x) = a.peek() {
+                    return Err(Error::deck(x.span, format!("run_style verlet: unexpected '{}'", x.text)));
+                }
+                Ok(())
+            }
+            "respa" | "verlet/split" | "respa/omp" | "verlet/kk" => Err(Error::unsupported(w.span, format!("run_style {}", w.text))),
+            _ => Err(args::bad_keyword(w, "run style", &["verlet", "respa", "verlet/split"])),
         }
     }
 
@@ -451,6 +411,9 @@ impl Session {
     }
 
     fn run_command(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
+        if self.sim.thermo.one {
+            self.sim.thermo.keywords = crate::engine::output::one_style(self.dialect_now());
+        }
         let mut a = Args::new(cmd);
         let n = a.i64("number of steps")?;
         let mut upto = false;
@@ -555,17 +518,6 @@ fn perturb_positions(p: &mut crate::engine::particles::Particles, seed: u64, amp
         }
     }
 }
-
-/// Every command name demx knows (for did-you-mean).
-pub const ALL_COMMANDS: &[&str] = &[
-    "units", "atom_style", "atom_modify",
-    "compute_modify", "boundary", "dimension", "newton", "communicate", "comm_modify", "processors",
-    "neighbor", "neigh_modify", "timestep", "region", "create_box", "lattice", "create_atoms", "read_data", "group", "set",
-    "velocity", "delete_atoms", "displace_atoms", "pair_style", "pair_coeff", "fix", "unfix", "compute", "uncompute",
-    "thermo", "thermo_style", "thermo_modify", "dump", "write_dump", "dump_modify", "undump", "run", "write_restart", "read_restart",
-    "write_data", "reset_timestep", "hard_particles", "soft_particles", "variable", "print", "include", "jump", "label",
-    "next", "if", "log", "echo", "quit", "mass", "demx_guard",
-];
 
 impl Session {
     /// Execute a replayed command (from a restart file) without recording it again.

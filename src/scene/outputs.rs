@@ -33,9 +33,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
         "thermo_style" => {
             let st = a.choice("thermo style", &["one", "multi", "custom", "yaml"])?;
             match st.text.as_str() {
-                "one" => {
-                    s.sim.thermo.keywords = ["step", "temp", "epair", "emol", "etotal", "press"].iter().map(|k| k.to_string()).collect();
-                }
+                "one" => s.sim.thermo.one = true,
                 "custom" => {
                     let mut ks = vec![];
                     for w in a.rest() {
@@ -46,6 +44,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                         return Err(Error::deck(a.end_span(), "thermo_style custom: no keywords"));
                     }
                     s.sim.thermo.keywords = ks;
+                    s.sim.thermo.one = false;
                 }
                 other => return Err(Error::unsupported(st.span, format!("thermo_style {other}"))),
             }
