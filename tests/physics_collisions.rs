@@ -407,3 +407,104 @@ fn lammps_tsuji_restitution_matches_lmp() {
         }
     }
 }
+
+mod common;
+
+type Frames = std::collections::BTreeMap<i64, std::collections::BTreeMap<i64, Vec<f64>>>;
+
+/// A grazing collision of two spheres falling onto a floor (the first
+/// spinning about z), with the
+/// contact model `model` (pair and wall) and the extra `props`, run by
+/// LIGGGHTS and by demx: their dumps (id x y z v omega), which must agree
+/// to rounding.
+fn grazing_pair(model: &str, props: &str) -> (Frames, Frames) {
+    let deck = format!("atom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
+region reg block -0.01 0.01 -0.01 0.01 0 0.01 units box\ncreate_box 1 reg\nneighbor 0.0005 bin\nneigh_modify delay 0\n\
+fix m1 all property/global youngsModulus peratomtype 5.e6\nfix m2 all property/global poissonsRatio peratomtype 0.45\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+{props}pair_style gran {model}\npair_coeff * *\ntimestep 1e-6\n\
+fix floor all wall/gran {model} primitive type 1 zplane 0.0\n\
+create_atoms 1 single -0.002 0.0 0.0012 units box\ncreate_atoms 1 single 0.002 0.0006 0.0011 units box\n\
+set group all diameter 0.002 density 2500\ngroup a id 1\ngroup b id 2\n\
+velocity a set 1.0 0.0 -0.3 units box\nvelocity b set -1.0 0.0 -0.2 units box\nset group a omegaz 50.0\n\
+fix 1 all nve/sphere\nfix g all gravity 9.81 vector 0.0 0.0 -1.0\n\
+dump d all custom 500 dump.c id x y z vx vy vz omegax omegay omegaz\n\
+dump_modify d sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\"\nrun 4000\n");
+    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &deck)]);
+    let (theirs, ours) = (common::dump_frames(&b.theirs.path().join("dump.c")), common::dump_frames(&b.ours.path().join("dump.c")));
+    assert_eq!(theirs.keys().collect::<Vec<_>>(), ours.keys().collect::<Vec<_>>());
+    // the spheres met (their x velocities turned)
+    let last = ours.values().last().unwrap();
+    assert!(last[&1][3] < 0.0 && last[&2][3] > 0.0, "{model}: no collision: {last:?}");
+    for (step, rows) in &theirs {
+        for (id, t) in rows {
+            let o = &ours[step][id];
+            for k in 0..9 {
+                let scale = if k < 3 { 0.01 } else { 1.0 };
+                assert!((t[k] - o[k]).abs() <= 1e-10 * scale, "{model}: step {step} atom {id} column {k}: liggghts {} demx {}", t[k], o[k]);
+            }
+        }
+    }
+    (theirs, ours)
+}
+
+/// LIGGGHTS `tangential off`: a grazing collision of two spheres (and of
+/// each with a floor) pushes only along the normals, so no sphere's spin
+/// changes, and the run is the one LIGGGHTS 3.8 makes, to rounding (with
+/// the spin that `set ... omegaz` gives one of them).
+#[test]
+fn tangential_off_pushes_along_the_normal_only_as_liggghts() {
+    let (_, ours) = grazing_pair("model hertz tangential off", "");
+    let (first, last) = (&ours[&0], ours.values().last().unwrap());
+    for (step, rows) in &ours {
+        for (id, o) in rows {
+            // no torque at any contact: sphere 1 keeps the spin `set omegaz`
+            // gave it, sphere 2 never spins
+            let spin = if *id == 1 { [0.0, 0.0, 50.0] } else { [0.0; 3] };
+            assert_eq!(o[6..9], spin, "step {step} atom {id}");
+        }
+    }
+    // the frictionless floor pushes along z only and the pair's pushes are
+    // equal and opposite: the y momentum stays (the spheres are alike)
+    let py = |rows: &std::collections::BTreeMap<i64, Vec<f64>>| rows[&1][4] + rows[&2][4];
+    assert!((py(first) - py(last)).abs() < 1e-12, "y momentum changed: {} -> {}", py(first), py(last));
+}
+
+/// `rolling_friction epsd3` reads its stiffness factor from
+/// `rollingStiffness` (a scalar), as LIGGGHTS 3.8 does (its documentation
+/// says coeffRollingStiffness, which the engine does not read): the
+/// spinning spheres' rolling torques as LIGGGHTS computes them.
+#[test]
+fn epsd3_reads_rolling_stiffness_as_liggghts() {
+    let props = "fix m5 all property/global coefficientRollingFriction peratomtypepair 1 0.3\n\
+fix m6 all property/global coefficientRollingViscousDamping peratomtypepair 1 0.2\n\
+fix m7 all property/global rollingStiffness scalar 2.0\n";
+    let (_, ours) = grazing_pair("model hertz tangential history rolling_friction epsd3", props);
+    let last = ours.values().last().unwrap();
+    assert!(last.values().all(|o| o[6..9].iter().any(|&w| w.abs() > 1.0)), "the spheres do not spin: {last:?}");
+}
+
+/// A LIGGGHTS deck without `thermo_style` prints LIGGGHTS's own columns
+/// (`Step Atoms KinEng CPU`), not LAMMPS's, and the same values (the CPU
+/// column is each program's clock); a LAMMPS deck keeps LAMMPS's.
+#[test]
+fn default_thermo_columns_are_the_dialects() {
+    let deck = "atom_style sphere\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
+region reg block 0 1 0 1 0 1 units box\ncreate_box 1 reg\nneighbor 0.01 bin\n\
+fix m1 all property/global youngsModulus peratomtype 5.e6\nfix m2 all property/global poissonsRatio peratomtype 0.45\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+pair_style gran model hertz tangential history\npair_coeff * *\ntimestep 1e-5\n\
+create_atoms 1 single 0.5 0.5 0.5\ncreate_atoms 1 single 0.2 0.5 0.5\nset group all diameter 0.1 density 2500\n\
+velocity all set 1 0 0\nfix 1 all nve/sphere\nfix g all gravity 9.81 vector 0 0 -1\nthermo 5\nrun 10\n";
+    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", deck)]);
+    let (theirs, ours) = (common::thermo_runs(&b.theirs_out), common::thermo_runs(&b.ours_out));
+    let header = |out: &str| out.lines().find(|l| l.trim_start().starts_with("Step")).map(|l| l.split_whitespace().collect::<Vec<_>>().join(" "));
+    assert_eq!(header(&b.theirs_out).as_deref(), Some("Step Atoms KinEng CPU"));
+    assert_eq!(header(&b.ours_out), header(&b.theirs_out));
+    assert_eq!(theirs[0].len(), 3, "{theirs:?}");
+    for (t, o) in theirs[0].iter().zip(&ours[0]) {
+        assert_eq!(t[..2], o[..2]);
+        let (kt, ko): (f64, f64) = (t[2].parse().unwrap(), o[2].parse().unwrap());
+        assert!(kt > 1.0 && (kt - ko).abs() <= 1e-7 * kt, "KinEng: liggghts {kt} demx {ko}");
+    }
+}

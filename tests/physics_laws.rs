@@ -504,7 +504,7 @@ fn epsd_family_spring_dashpot_cap_and_signs() {
     let mut out = normal_out(1.0, kt, 0.0);
     LiggghtsEpsd2::default().rolling(&c, &p, &mut h, &mut out);
     assert!(rel(out.torque_i.x, -kt * rs * rs * w * dt) < 1e-12);
-    // epsd3: coeffRollingStiffness replaces 2.25
+    // epsd3: rollingStiffness replaces 2.25
     let mut h = [0.0; 3];
     let mut out = normal_out(1.0, kt, 0.0);
     out.kn = kn;

@@ -222,7 +222,7 @@ fn rolling_sds(ctx: &mut Ctx, m: &Model3, p: &Pair, i: usize, j: usize) -> Optio
     let k_roll = match r {
         "epsd" => 2.25 * kn * mu_r * mu_r,
         "epsd2" => kt,
-        _ => f.props.get("coeffRollingStiffness").and_then(|pr| pr.values.first()).and_then(|v| f.num(v)).map(|c| c * kn * mu_r * mu_r)?,
+        _ => f.props.get("rollingStiffness").and_then(|pr| pr.values.first()).and_then(|v| f.num(v)).map(|c| c * kn * mu_r * mu_r)?,
     };
     ctx.note(
         Severity::Approx,

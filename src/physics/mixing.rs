@@ -75,7 +75,7 @@ pub struct LiggghtsMaterials {
     pub cohesion_energy_density: Option<Vec<f64>>,
     /// `characteristicVelocity` scalar.
     pub char_vel: Option<f64>,
-    /// `coeffRollingStiffness` scalar (epsd3).
+    /// `rollingStiffness` scalar (epsd3).
     pub rolling_stiffness: Option<f64>,
     /// `kn` per type pair (…/stiffness).
     pub kn: Option<Vec<f64>>,

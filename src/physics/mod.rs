@@ -151,7 +151,7 @@ pub struct PairParams {
     pub mu_r: f64,
     /// Rolling viscous damping coefficient (epsd, epsd3).
     pub eta_r: f64,
-    /// Rolling stiffness coefficient (epsd3 `coeffRollingStiffness`, 2.25 for epsd).
+    /// Rolling stiffness coefficient (epsd3 `rollingStiffness`, 2.25 for epsd).
     pub k_r_coeff: f64,
     /// Cohesion energy density (sjkr, sjkr2), J/m^3; or surface energy gamma
     /// (vdw, dmt, jkr), J/m^2.
@@ -614,7 +614,7 @@ check_flip! {
     NormalLaw: normal::hooke::LiggghtsHooke, normal::hooke_stiffness::LiggghtsHookeStiffness, normal::hertz::LiggghtsHertz,
         normal::hertz_stiffness::LiggghtsHertzStiffness, normal::viscoelastic::PaperViscoelastic, normal::gran::LammpsGranHooke,
         normal::gran::LammpsGranHertz, normal::granular::LammpsGranular, normal::dmt::LammpsDmt, normal::jkr::LammpsJkr;
-    TangentialLaw: tangential::no_history::LiggghtsNoHistory, tangential::history::LiggghtsHistory, tangential::paper::PaperCundallStrack,
+    TangentialLaw: tangential::off::LiggghtsOff, tangential::no_history::LiggghtsNoHistory, tangential::history::LiggghtsHistory, tangential::paper::PaperCundallStrack,
         tangential::gran::LammpsGranNoHistory, tangential::gran::LammpsGranHistory, tangential::granular::LammpsLinearNoHistory,
         tangential::granular::LammpsGranularHistory;
     CohesionLaw: NoCohesion, cohesion::sjkr::LiggghtsSjkr, cohesion::sjkr2::LiggghtsSjkr2, cohesion::vdw::Hamaker;

@@ -21,6 +21,17 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
     let t0: f64 = format!("{:.6}", parse_f64(w)?).parse().map_err(|_| Error::deck(w.span, format!("fix {name}: initial_temperature must be finite")))?;
     let mut area = ContactArea::Overlap;
     while a.more() {
+        // LIGGGHTS reads keywords until the first word it does not know and
+        // ignores that word and all after it (fix_heat_gran_conduction.cpp:
+        // its loop ends when no keyword matched; checked with LIGGGHTS 3.8:
+        // `initial_temperature 300. 400. area_correction yes` runs at 300 K
+        // without the correction)
+        if a.peek().is_some_and(|w| !["contact_area", "area_correction"].contains(&w.text.as_str())) {
+            let rest: Vec<String> = a.rest().iter().map(|w| w.text.clone()).collect();
+            a.pos += rest.len();
+            s.notes.push((cmd.span, format!("fix {name}: '{}' ignored, as LIGGGHTS 3.8 ignores the words after the last keyword it reads", rest.join(" "))));
+            break;
+        }
         let k = a.choice("keyword", &["contact_area", "area_correction"])?;
         match k.text.as_str() {
             "contact_area" => {

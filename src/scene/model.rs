@@ -76,6 +76,8 @@ pub enum GranularTwisting {
 /// Tangential law of a scene.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum TangentialSpec {
+    /// LIGGGHTS `tangential off` (no tangential force).
+    LigOff,
     /// LIGGGHTS `tangential no_history`.
     LigNoHistory,
     /// LIGGGHTS `tangential history`.
@@ -232,6 +234,7 @@ impl PairSpec {
             TangentialSpec::LigNoHistory | TangentialSpec::GranNoHistory | TangentialSpec::LinearNoHistory => "tangential no_history".to_string(),
             TangentialSpec::LigHistory | TangentialSpec::GranHistory => "tangential history".into(),
             TangentialSpec::PaperHistory => "tangential history/paper".into(),
+            TangentialSpec::LigOff => "tangential off".into(),
             TangentialSpec::Granular(g) => format!("tangential {g:?}").to_lowercase(),
         };
         let c = match self.cohesion {
@@ -293,6 +296,7 @@ pub fn build_kernel(spec: &PairSpec) -> Result<Box<dyn ContactKernel>> {
 
 fn lig_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
     match spec.tangential {
+        TangentialSpec::LigOff => lig_cohesion(n, tangential::off::LiggghtsOff, spec),
         TangentialSpec::LigNoHistory => lig_cohesion(n, tangential::no_history::LiggghtsNoHistory, spec),
         TangentialSpec::LigHistory => lig_cohesion(n, tangential::history::LiggghtsHistory, spec),
         TangentialSpec::PaperHistory => lig_cohesion(n, tangential::paper::PaperCundallStrack, spec),
@@ -528,11 +532,12 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
             "tangential" => {
                 let t = a.word("tangential model")?;
                 spec.tangential = match t.text.as_str() {
+                    "off" => TangentialSpec::LigOff,
                     "no_history" => TangentialSpec::LigNoHistory,
                     "history" => TangentialSpec::LigHistory,
                     "history/paper" => TangentialSpec::PaperHistory,
                     "tan_luding" => return Err(Error::unsupported(t.span, "LIGGGHTS tangential model 'tan_luding'")),
-                    _ => return Err(bad_keyword(t, "tangential model", &["no_history", "history", "history/paper"])),
+                    _ => return Err(bad_keyword(t, "tangential model", &["off", "no_history", "history", "history/paper"])),
                 };
             }
             "cohesion" => {
@@ -860,7 +865,7 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                 rolling_damping: per_pair("coefficientRollingViscousDamping")?,
                 cohesion_energy_density: per_pair("cohesionEnergyDensity")?,
                 char_vel: scalar("characteristicVelocity"),
-                rolling_stiffness: scalar("coeffRollingStiffness"),
+                rolling_stiffness: scalar("rollingStiffness"),
                 kn: per_pair("kn")?,
                 kt: per_pair("kt")?,
                 gamman: per_pair("gamman")?,
@@ -900,11 +905,18 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                 needed.push(("coefficientRollingViscousDamping", m.rolling_damping.is_some()));
             }
             if matches!(spec.rolling, RollingSpec::Epsd3 { .. }) {
-                needed.push(("coeffRollingStiffness", m.rolling_stiffness.is_some()));
+                // LIGGGHTS 3.8's rolling_model_epsd3.h reads `rollingStiffness`
+                // (a scalar); its documentation names it coeffRollingStiffness,
+                // which the engine refuses as missing
+                needed.push(("rollingStiffness", m.rolling_stiffness.is_some()));
             }
             if let Some((name, _)) = needed.iter().find(|(_, have)| !have) {
-                return Err(Error::deck(span, format!("this contact model needs `fix ID all property/global {name} ...`"))
-                    .with_hint("LIGGGHTS reads material properties from fix property/global, defined before the run"));
+                let hint = if *name == "rollingStiffness" && prop(s, "coeffRollingStiffness").is_some() {
+                    "LIGGGHTS 3.8 reads the epsd3 stiffness factor as `rollingStiffness scalar C`: the name coeffRollingStiffness of its documentation is not read (the engine stops the same way)"
+                } else {
+                    "LIGGGHTS reads material properties from fix property/global, defined before the run"
+                };
+                return Err(Error::deck(span, format!("this contact model needs `fix ID all property/global {name} ...`")).with_hint(hint));
             }
             if s.units == super::Units::Si && !s.hard_particles {
                 if let Some(y) = m.youngs.as_ref().and_then(|y| y.iter().cloned().find(|&v| v > 1e9)) {

@@ -705,7 +705,11 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
                 "vx" => p.v[i].x = val,
                 "vy" => p.v[i].y = val,
                 "vz" => p.v[i].z = val,
-                "omega" => return Err(Error::unsupported(k.span, "set omega (use velocity or omega per component)")),
+                // LIGGGHTS 3.8 set.cpp: one angular velocity component each
+                "omegax" => p.omega[i].x = val,
+                "omegay" => p.omega[i].y = val,
+                "omegaz" => p.omega[i].z = val,
+                "omega" => return Err(Error::unsupported(k.span, "set omega (use omegax, omegay, omegaz)")),
                 "x" => p.x[i].x = val,
                 "y" => p.x[i].y = val,
                 "z" => p.x[i].z = val,

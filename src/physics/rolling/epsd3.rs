@@ -1,5 +1,5 @@
 //! LIGGGHTS `rolling_friction epsd3` (source `rolling_model_epsd3.h`): as
-//! epsd with the user stiffness factor `coeffRollingStiffness` in place of
+//! epsd with the user stiffness factor `rollingStiffness` in place of
 //! 2.25: k_r = c k_n mu_r^2 R^2.
 
 use super::{epsd_torque, liggghts_rolling_inertia, liggghts_rotation};

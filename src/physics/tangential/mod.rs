@@ -15,6 +15,7 @@ pub mod gran;
 pub mod granular;
 pub mod history;
 pub mod no_history;
+pub mod off;
 pub mod paper;
 
 use super::lanes::{Real, Vec3};
