@@ -270,3 +270,51 @@ fn campaign_resumes_from_its_folder_anywhere_and_matches_uninterrupted_runs() {
         assert_eq!(r["theta_deg"].as_f64(), rep["repose"]["theta"].as_f64(), "run {n}: theta_r as `demx repose` measures the uninterrupted heap");
     }
 }
+
+/// `demx campaign --stop` from another shell: the running campaign asks its
+/// runs to stop, each stops at its next checkpoint (exit 75 for the
+/// campaign), and the next start finishes the run from there.
+#[test]
+fn campaign_stop_reaches_a_running_campaign_and_it_resumes() {
+    let deck = root().join("templates/heap/in.heap");
+    let spec = serde_json::json!({
+        "deck": deck,
+        "vars": { "d": "1e-3", "g": "1", "Y": "1e7", "N": "300", "model": "stock", "relax": "4", "seed": "15485863" },
+        "runs": [{ "name": "a", "estimate_core_h": 0.01 }],
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("c.json"), serde_json::to_string_pretty(&spec).unwrap()).unwrap();
+    let demx = || {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_demx"));
+        c.current_dir(d).args(["campaign", "c.json"]);
+        c
+    };
+    let mut runner = demx().stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+    // the run has started (its folder holds its log)
+    let t0 = std::time::Instant::now();
+    while !d.join("runs/a/work/log.demx").exists() {
+        assert!(t0.elapsed().as_secs() < 60, "the run did not start");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let o = demx().arg("--stop").output().unwrap();
+    assert!(o.status.success(), "{}", said(&o));
+    let t1 = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = runner.try_wait().unwrap() {
+            break s;
+        }
+        assert!(t1.elapsed().as_secs() < 300, "the campaign did not stop");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    };
+    let out = runner.wait_with_output().unwrap();
+    assert_eq!(status.code(), Some(75), "{}", said(&out));
+    assert!(d.join("runs/a/ckpt/checkpoint.json.gz").exists(), "no checkpoint: {}", said(&out));
+    assert!(!d.join("STOP").exists() && !d.join("runs/a/ckpt/STOP").exists(), "a stop request is left behind");
+    let st = demx().arg("--status").output().unwrap();
+    assert!(String::from_utf8_lossy(&st.stdout).contains("resumable"), "{}", said(&st));
+    let o = demx().output().unwrap();
+    assert!(o.status.success(), "{}", said(&o));
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("runs/a/result.json")).unwrap()).unwrap();
+    assert_eq!(r["segments"].as_array().unwrap().len(), 2, "two stretches: {r}");
+}
