@@ -90,9 +90,7 @@ impl Error {
     /// The span the error points at, if any.
     pub fn span(&self) -> Option<Span> {
         match self {
-            Error::Deck { span, .. } | Error::Unsupported { span, .. } | Error::Io { span, .. } => {
-                Some(*span).filter(|s| s.is_real())
-            }
+            Error::Deck { span, .. } | Error::Unsupported { span, .. } | Error::Io { span, .. } => Some(*span).filter(|s| s.is_real()),
             _ => None,
         }
     }

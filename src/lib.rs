@@ -8,17 +8,17 @@
 //! translates dialects, `cli` is the command line.
 #![warn(missing_docs)]
 
-pub mod error;
-pub mod script;
-pub mod physics;
-pub mod geom;
-pub mod engine;
-pub mod scene;
-pub mod io;
 pub mod analysis;
-pub mod convert;
 pub mod cli;
-pub mod plot;
+pub mod convert;
+pub mod engine;
+pub mod error;
+pub mod geom;
+pub mod io;
 pub mod limits;
+pub mod physics;
+pub mod plot;
+pub mod scene;
+pub mod script;
 
 pub use error::{Error, Result};

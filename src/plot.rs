@@ -133,11 +133,7 @@ pub fn check_path(path: &Path) -> Result<()> {
     }
     let dir = parent_dir(path);
     if !dir.is_dir() {
-        return Err(Error::usage(format!(
-            "cannot write plot '{}': directory '{}' does not exist",
-            path.display(),
-            dir.display()
-        )));
+        return Err(Error::usage(format!("cannot write plot '{}': directory '{}' does not exist", path.display(), dir.display())));
     }
     if path.is_dir() {
         return Err(Error::usage(format!("cannot write plot '{}': it is a directory", path.display())));
@@ -159,11 +155,7 @@ pub fn write_png(path: &Path, charts: &[Chart]) -> Result<()> {
         return Err(Error::usage(format!("cannot write plot '{}': nothing to plot", path.display())));
     }
     if charts.len() > MAX_PANELS {
-        return Err(Error::usage(format!(
-            "cannot write plot '{}': {} panels (at most {MAX_PANELS})",
-            path.display(),
-            charts.len()
-        )));
+        return Err(Error::usage(format!("cannot write plot '{}': {} panels (at most {MAX_PANELS})", path.display(), charts.len())));
     }
     let text = text_enabled();
     let (w, h) = (PANEL_SIZE.0 * charts.len() as u32, PANEL_SIZE.1);
@@ -195,11 +187,7 @@ pub fn write_png(path: &Path, charts: &[Chart]) -> Result<()> {
 /// then rename it to `path`.
 fn save_atomically(path: &Path, buf: &[u8], (w, h): (u32, u32)) -> Result<()> {
     let io = |e: &dyn std::fmt::Display| Error::usage(format!("cannot write plot '{}': {e}", path.display()));
-    let tmp = tempfile::Builder::new()
-        .prefix(".demx-plot-")
-        .suffix(".png")
-        .tempfile_in(parent_dir(path))
-        .map_err(|e| io(&e))?;
+    let tmp = tempfile::Builder::new().prefix(".demx-plot-").suffix(".png").tempfile_in(parent_dir(path)).map_err(|e| io(&e))?;
     {
         let mut bm = BitMapBackend::new(tmp.path(), (w, h));
         bm.blit_bitmap((0, 0), (w, h), buf).map_err(|e| io(&e))?;

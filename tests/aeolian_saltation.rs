@@ -39,12 +39,8 @@ fn flux_from_dump_frames() {
     let area = 0.01 * 0.002;
     let q1 = (m(1e-4) * 1.5 + m(1.2e-4) * 4.0) / area;
     let q2 = (m(1e-4) * 2.5 + m(1.2e-4) * 6.0) / area;
-    let rows: Vec<Vec<f64>> = csv
-        .lines()
-        .skip(1)
-        .filter(|l| !l.starts_with('#'))
-        .map(|l| l.split(',').map(|w| w.parse().unwrap()).collect())
-        .collect();
+    let rows: Vec<Vec<f64>> =
+        csv.lines().skip(1).filter(|l| !l.starts_with('#')).map(|l| l.split(',').map(|w| w.parse().unwrap()).collect()).collect();
     assert_eq!(rows.len(), 3);
     assert!((rows[1][2] - q1).abs() < 1e-8 * q1 && (rows[2][2] - q2).abs() < 1e-8 * q2);
     let summary = csv.lines().last().unwrap().trim_start_matches("# ");

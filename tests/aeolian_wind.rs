@@ -10,11 +10,8 @@ use std::process::Command;
 
 fn demx(dir: &Path, deck: &str) {
     std::fs::write(dir.join("in.deck"), deck).expect("write deck");
-    let out = Command::new(env!("CARGO_BIN_EXE_demx"))
-        .current_dir(dir)
-        .args(["run", "--quiet", "--log", "none", "in.deck"])
-        .output()
-        .expect("run demx");
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_demx")).current_dir(dir).args(["run", "--quiet", "--log", "none", "in.deck"]).output().expect("run demx");
     assert!(out.status.success(), "demx failed: {}\n{deck}", String::from_utf8_lossy(&out.stderr));
 }
 

@@ -10,11 +10,7 @@ fn closed_stdout_ends_demx_without_a_panic() {
     use std::os::unix::process::ExitStatusExt;
     let dir = tempfile::tempdir().unwrap();
     let deck = dir.path().join("in.print");
-    std::fs::write(
-        &deck,
-        "variable i loop 1000000\nlabel l\nprint \"line $i of many\"\nnext i\njump SELF l\n",
-    )
-    .unwrap();
+    std::fs::write(&deck, "variable i loop 1000000\nlabel l\nprint \"line $i of many\"\nnext i\njump SELF l\n").unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_demx"))
         .current_dir(dir.path())
         .args(["run", "in.print", "--log", "none"])
@@ -29,14 +25,6 @@ fn closed_stdout_ends_demx_without_a_panic() {
     drop(out); // the reader is gone
     let done = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&done.stderr);
-    assert!(
-        !err.contains("panicked"),
-        "demx panicked on a closed pipe:\n{err}"
-    );
-    assert_eq!(
-        done.status.signal(),
-        Some(13),
-        "ended by SIGPIPE: {:?}\n{err}",
-        done.status
-    );
+    assert!(!err.contains("panicked"), "demx panicked on a closed pipe:\n{err}");
+    assert_eq!(done.status.signal(), Some(13), "ended by SIGPIPE: {:?}\n{err}", done.status);
 }

@@ -18,12 +18,7 @@ fn against(deck: &str, engine: &str) -> Option<(i32, String)> {
         return None;
     }
     let deck = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("templates").join(deck);
-    let o = Command::new(env!("CARGO_BIN_EXE_demx"))
-        .arg("compare")
-        .arg(&deck)
-        .args(["--against", engine])
-        .output()
-        .expect("run demx compare");
+    let o = Command::new(env!("CARGO_BIN_EXE_demx")).arg("compare").arg(&deck).args(["--against", engine]).output().expect("run demx compare");
     let out = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     Some((o.status.code().unwrap_or(-1), out))
 }
@@ -112,16 +107,18 @@ fn reference_collects_or_explains() {
     assert!(std::fs::read_to_string(out.join("version.txt")).unwrap().starts_with("LAMMPS (29 Sep 2021"));
     let dump = std::fs::read_to_string(out.join("dump.headon")).unwrap();
     // full precision (%20.15g): positions during the collision carry 15 significant digits, %g only 6
-    assert!(
-        dump.split_whitespace().any(|w| w.split('e').next().unwrap().chars().filter(|c| c.is_ascii_digit()).count() >= 15),
-        "{}",
-        &dump[..600]
-    );
+    assert!(dump.split_whitespace().any(|w| w.split('e').next().unwrap().chars().filter(|c| c.is_ascii_digit()).count() >= 15), "{}", &dump[..600]);
     let rec: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("reference.json")).unwrap()).unwrap();
     assert_eq!(rec["dumps"][0], "dump.headon");
     // an engine error: the LIGGGHTS deck is not a LAMMPS deck
     let lig = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("templates/two_sphere/in.headon.liggghts");
-    let o = Command::new(env!("CARGO_BIN_EXE_demx")).arg("reference").arg(&lig).args(["--engine", "lammps", "--out"]).arg(dir.path().join("y")).output().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_demx"))
+        .arg("reference")
+        .arg(&lig)
+        .args(["--engine", "lammps", "--out"])
+        .arg(dir.path().join("y"))
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("ERROR: Unrecognized atom style 'granular'"));
 }

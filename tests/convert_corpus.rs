@@ -85,7 +85,18 @@ fn check_json(text: &str, dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("json")
 }
 
-const LEGACY_WORDS: &[&str] = &["gran/hertz/history", "gran/hooke/history", "gran/hooke", "mesh/gran", "move/mesh/gran", "pour/legacy", "pour/dev", "pour", "stl", "mesh/gran/VTK"];
+const LEGACY_WORDS: &[&str] = &[
+    "gran/hertz/history",
+    "gran/hooke/history",
+    "gran/hooke",
+    "mesh/gran",
+    "move/mesh/gran",
+    "pour/legacy",
+    "pour/dev",
+    "pour",
+    "stl",
+    "mesh/gran/VTK",
+];
 
 #[test]
 fn every_liggghts2_deck_converts_and_liggghts_parses_it() {
@@ -257,7 +268,11 @@ fn text_is_kept_and_legacy_rewritten() {
     assert_eq!(lines[3], "label loop");
     assert_eq!(lines[4], "pair_style gran model hertz tangential history cohesion sjkr rolling_friction cdt # rolling and cohesion");
     assert_eq!(lines[5], "fix w all wall/gran model hooke tangential history primitive type 2 xplane 0.5 tangential_damping off");
-    assert!(lines[6].starts_with("fix ins all insert/rate/region seed 15485863 distributiontemplate pdd mass 0.1 massrate 0.5 insert_every "), "{}", lines[6]);
+    assert!(
+        lines[6].starts_with("fix ins all insert/rate/region seed 15485863 distributiontemplate pdd mass 0.1 massrate 0.5 insert_every "),
+        "{}",
+        lines[6]
+    );
     assert!(lines[6].ends_with(" overlapcheck yes vel constant 0 0 -1 region r"));
     assert_eq!(lines[7], "unfix w");
     assert_eq!(lines[8], "jump SELF loop");

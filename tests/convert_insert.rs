@@ -129,17 +129,32 @@ fn insert_once_volume_fraction_gives_the_liggghts_count_without_overlaps() {
 fn insert_every_counts_the_insertions_until_unfix() {
     // refills every 3000 steps: runs of 1 and 10000 steps (steps 1..10001)
     // see insertions at steps 1, 3001, 6001 and 9001, then `unfix`
-    let deck = pack_deck("particles_in_region 250").replace("insert_every once", "insert_every 3000").replace(
-        "run 1\n",
-        "thermo_modify lost ignore\nrun 1\nrun 10000\nunfix ins\nrun 5000\n",
-    );
+    let deck = pack_deck("particles_in_region 250")
+        .replace("insert_every once", "insert_every 3000")
+        .replace("run 1\n", "thermo_modify lost ignore\nrun 1\nrun 10000\nunfix ins\nrun 5000\n");
     let c = convert(&deck, Target::Lammps);
     // a packing pass now, and the runs split before the insertion steps 3001,
     // 6001 and 9001, each followed by a pass; `unfix ins` ends them
-    let cmds: Vec<String> = c.text.lines().filter(|l| l.starts_with("run") || l.starts_with("label demx_rsa") && !l.ends_with("_end") || l.starts_with("unfix")).map(|l| l.split_whitespace().collect::<Vec<_>>().join(" ")).collect();
+    let cmds: Vec<String> = c
+        .text
+        .lines()
+        .filter(|l| l.starts_with("run") || l.starts_with("label demx_rsa") && !l.ends_with("_end") || l.starts_with("unfix"))
+        .map(|l| l.split_whitespace().collect::<Vec<_>>().join(" "))
+        .collect();
     assert_eq!(
         cmds,
-        ["label demx_rsa1_1", "run 1", "run 2999", "label demx_rsa1_2", "run 3000", "label demx_rsa1_3", "run 3000", "label demx_rsa1_4", "run 1001", "run 5000"],
+        [
+            "label demx_rsa1_1",
+            "run 1",
+            "run 2999",
+            "label demx_rsa1_2",
+            "run 3000",
+            "label demx_rsa1_3",
+            "run 3000",
+            "label demx_rsa1_4",
+            "run 1001",
+            "run 5000"
+        ],
         "{}",
         c.text
     );
@@ -256,7 +271,8 @@ write_dump all custom ids.txt id z
 /// delete_atoms overlap, jump SELF loop, reset_timestep).
 #[test]
 fn demx_runs_the_converted_random_packing() {
-    let deck = pack_deck("particles_in_region 300").replace("fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n", "");
+    let deck =
+        pack_deck("particles_in_region 300").replace("fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n", "");
     let c = convert(&deck, Target::Lammps);
     let dir = tempfile::tempdir().expect("tmp");
     std::fs::write(dir.path().join("in.deck"), &c.text).expect("write");

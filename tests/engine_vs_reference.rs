@@ -186,10 +186,7 @@ fn frame_ke(f: &Frame, density: f64) -> f64 {
 fn paired<'a>(reference: &'a [Frame], demx: &'a [Frame]) -> Vec<(&'a Frame, &'a Frame)> {
     let by_step: HashMap<u64, &Frame> = demx.iter().map(|f| (f.timestep, f)).collect();
     assert_eq!(reference.len(), demx.len(), "frame counts differ");
-    reference
-        .iter()
-        .map(|r| (r, *by_step.get(&r.timestep).unwrap_or_else(|| panic!("demx has no frame at step {}", r.timestep))))
-        .collect()
+    reference.iter().map(|r| (r, *by_step.get(&r.timestep).unwrap_or_else(|| panic!("demx has no frame at step {}", r.timestep)))).collect()
 }
 
 /// A collision case: every frame agrees to the stored tolerances.

@@ -17,7 +17,8 @@ use std::path::Path;
 fn data() -> String {
     let k = 8;
     let n = k * k * k;
-    let mut s = format!("overlapping spheres\n\n{n} atoms\n1 atom types\n\n-0.008 0.008 xlo xhi\n-0.008 0.008 ylo yhi\n0.0 0.04 zlo zhi\n\nAtoms\n\n");
+    let mut s =
+        format!("overlapping spheres\n\n{n} atoms\n1 atom types\n\n-0.008 0.008 xlo xhi\n-0.008 0.008 ylo yhi\n0.0 0.04 zlo zhi\n\nAtoms\n\n");
     for i in 0..n {
         let (x, y, z) = (-0.0069 + 0.00198 * (i % k) as f64, -0.0069 + 0.00198 * ((i / k) % k) as f64, 0.0012 + 0.00198 * (i / (k * k)) as f64);
         s += &format!("{} 1 0.002 2500 {x} {y} {z}\n", i + 1);

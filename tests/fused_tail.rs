@@ -22,7 +22,8 @@ use demx::engine::sim::with_unfused_tail;
 fn data() -> String {
     let k = 15;
     let n = k * k * k;
-    let mut s = format!("overlapping spheres\n\n{n} atoms\n1 atom types\n\n-0.016 0.016 xlo xhi\n-0.016 0.016 ylo yhi\n0.0 0.06 zlo zhi\n\nAtoms\n\n");
+    let mut s =
+        format!("overlapping spheres\n\n{n} atoms\n1 atom types\n\n-0.016 0.016 xlo xhi\n-0.016 0.016 ylo yhi\n0.0 0.06 zlo zhi\n\nAtoms\n\n");
     let frac = |i: usize, a: f64| (i as f64 * a).fract();
     for i in 0..n {
         let (x, y, z) = (-0.0139 + 0.00198 * (i % k) as f64, -0.0139 + 0.00198 * ((i / k) % k) as f64, 0.0012 + 0.00198 * (i / (k * k)) as f64);

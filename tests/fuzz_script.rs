@@ -77,11 +77,53 @@ impl XorShift {
 }
 
 const TOKENS: &[&str] = &[
-    "${", "$(", "}", ")", "(", "\"\"\"", "\"", "'", "&", "&\n", "#", "\n", " ", "$", "$a", "${v}", "$(v_v*2)", "$(1/0)", "$(2^3:%.3f)",
-    "jump SELF a\n", "label a\n", "next v\n", "variable v loop 3\n", "variable v index 1 2 3\n", "variable v equal v_v+1\n",
-    "variable a equal sqrt(-1)\n", "if \"${v} > 1\" then \"jump SELF a\" else \"next v\"\n", "if ", " then ", " elif ", " else ",
-    "print \"${v}\"\n", "run 10 every 3 \"print $(step)\"\n", "include in.none\n", "quit\n", "echo screen\n", "variable f format v %.3f\n",
-    "variable s string \"a b\"\n", "v_v", "x[1]", "c_1[2]", "ramp(0,1)", "\u{e9}", "\r\n", "\"\"\"\nq\n\"\"\"", "variable w atom x*2\n", "v_w[2]",
+    "${",
+    "$(",
+    "}",
+    ")",
+    "(",
+    "\"\"\"",
+    "\"",
+    "'",
+    "&",
+    "&\n",
+    "#",
+    "\n",
+    " ",
+    "$",
+    "$a",
+    "${v}",
+    "$(v_v*2)",
+    "$(1/0)",
+    "$(2^3:%.3f)",
+    "jump SELF a\n",
+    "label a\n",
+    "next v\n",
+    "variable v loop 3\n",
+    "variable v index 1 2 3\n",
+    "variable v equal v_v+1\n",
+    "variable a equal sqrt(-1)\n",
+    "if \"${v} > 1\" then \"jump SELF a\" else \"next v\"\n",
+    "if ",
+    " then ",
+    " elif ",
+    " else ",
+    "print \"${v}\"\n",
+    "run 10 every 3 \"print $(step)\"\n",
+    "include in.none\n",
+    "quit\n",
+    "echo screen\n",
+    "variable f format v %.3f\n",
+    "variable s string \"a b\"\n",
+    "v_v",
+    "x[1]",
+    "c_1[2]",
+    "ramp(0,1)",
+    "\u{e9}",
+    "\r\n",
+    "\"\"\"\nq\n\"\"\"",
+    "variable w atom x*2\n",
+    "v_w[2]",
 ];
 
 fn seeds() -> Vec<Vec<u8>> {
@@ -98,7 +140,8 @@ fn seeds() -> Vec<Vec<u8>> {
         dirs.sort();
         for d in dirs {
             if let Ok(rd) = std::fs::read_dir(&d) {
-                let mut f: Vec<_> = rd.flatten().map(|e| e.path()).filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("in."))).collect();
+                let mut f: Vec<_> =
+                    rd.flatten().map(|e| e.path()).filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("in."))).collect();
                 f.sort();
                 files.extend(f);
             }

@@ -1,8 +1,8 @@
 //! Lattice points of create_atoms vs real LAMMPS (29 Sep 2021, 1 proc) dumps
 //! in tests/data/geom (deck: tests/data/geom/in.lattice).
 
-use demx::geom::region::{parse_region, RegionParseCtx};
 use demx::geom::parse_lattice;
+use demx::geom::region::{parse_region, RegionParseCtx};
 use demx::physics::V3;
 use demx::script::{Command, Span, Word};
 

@@ -1,6 +1,6 @@
 //! STL reading (ASCII vs binary), transforms, sphere-triangle contact, bins, mesh motion.
 
-use demx::geom::mesh::{parse_mesh_transforms, closest_point_on_triangle};
+use demx::geom::mesh::{closest_point_on_triangle, parse_mesh_transforms};
 use demx::geom::{read_stl, read_stl_bytes, sphere_triangle_contact, ContactKind, Mesh, MeshMotion, MeshTransform, Triangle, TriangleBins};
 use demx::physics::V3;
 use demx::script::{Command, Span, Word};

@@ -369,7 +369,7 @@ fn jkr_headon_slow_sticks_like_lmp() {
         vt: 0.0,
         w: 0.0,
         steps: 4000,
-            skin: 0.0005,
+        skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -391,7 +391,7 @@ fn jkr_headon_fast_rebounds_like_lmp() {
         vt: 0.0,
         w: 0.0,
         steps: 2500,
-            skin: 0.0005,
+        skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -439,7 +439,7 @@ fn jkr_oblique_rolling_twisting_marshall_like_lmp() {
         vt: 0.001,
         w: 20.0,
         steps: 3000,
-            skin: 0.0005,
+        skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -461,7 +461,7 @@ fn dmt_oblique_twisting_marshall_like_lmp() {
         vt: 0.01,
         w: 100.0,
         steps: 1500,
-            skin: 0.0005,
+        skin: 0.0005,
     };
     if let Some((worst, frames)) = compare(&c) {
         assert!(worst < TOL, "{worst}");
@@ -513,7 +513,7 @@ fn jkr_oblique_sliding_like_lmp() {
         vt: 0.01,
         w: 100.0,
         steps: 1500,
-            skin: 0.0005,
+        skin: 0.0005,
     };
     if let Some((worst, _)) = compare(&c) {
         assert!(worst < TOL, "{worst}");

@@ -38,11 +38,7 @@ fn matches_glibc_table() {
         let mut it = line.splitn(4, '\t');
         let (fmt, kind, arg, out) = (it.next().unwrap(), it.next().unwrap(), it.next().unwrap(), it.next().unwrap());
         let want = &out[1..out.len() - 1];
-        let got = if kind == "f" {
-            sprintf(fmt, &[CArg::Float(parse_hex_float(arg))])
-        } else {
-            sprintf(fmt, &[CArg::Int(arg.parse().unwrap())])
-        };
+        let got = if kind == "f" { sprintf(fmt, &[CArg::Float(parse_hex_float(arg))]) } else { sprintf(fmt, &[CArg::Int(arg.parse().unwrap())]) };
         match got {
             Ok(g) if g == want => {}
             other => bad.push(format!("{fmt} {arg}: want [{want}] got {other:?}")),

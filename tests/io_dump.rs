@@ -94,10 +94,8 @@ fn rewrite_same(name: &str, opts: DumpOptions, out_name: Option<&str>) {
     assert_eq!(got, want, "rewriting {name} changed bytes");
 }
 
-const LMP_COLS: &[&str] = &[
-    "id", "type", "x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz", "omegax", "omegay", "omegaz", "radius", "mass", "ix",
-    "iy", "iz",
-];
+const LMP_COLS: &[&str] =
+    &["id", "type", "x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz", "omegax", "omegay", "omegaz", "radius", "mass", "ix", "iy", "iz"];
 
 #[test]
 fn writes_lammps_custom_and_atom_byte_for_byte() {
@@ -143,10 +141,7 @@ fn writes_padded_multi_file_dumps_like_lammps() {
         for f in read(name) {
             w.write_frame(&f).unwrap();
         }
-        assert_eq!(
-            std::fs::read_to_string(dir.path().join(name)).unwrap(),
-            std::fs::read_to_string(p(name)).unwrap()
-        );
+        assert_eq!(std::fs::read_to_string(dir.path().join(name)).unwrap(), std::fs::read_to_string(p(name)).unwrap());
     }
 }
 
@@ -208,7 +203,11 @@ fn truncated_last_frame_keeps_complete_frames() {
     let start4 = text.match_indices("ITEM: TIMESTEP").nth(3).unwrap().0;
     let atoms4 = start4 + text[start4..].find("ITEM: ATOMS").unwrap();
     let line_ends: Vec<usize> = text[atoms4..].match_indices('\n').map(|(i, _)| atoms4 + i + 1).collect();
-    for (cut, what) in [(line_ends[2], "2 of 6 atom lines"), (line_ends[3] - 7, "2 of 6 atom lines present, the next one is cut"), (start4 + 20, "file ends in the middle of a line")] {
+    for (cut, what) in [
+        (line_ends[2], "2 of 6 atom lines"),
+        (line_ends[3] - 7, "2 of 6 atom lines present, the next one is cut"),
+        (start4 + 20, "file ends in the middle of a line"),
+    ] {
         let f = dir.path().join("cut.dump");
         std::fs::write(&f, &text[..cut]).unwrap();
         let mut r = DumpReader::open(&f).unwrap();
@@ -270,9 +269,7 @@ fn run_engine(exe: &str, dir: &Path, deck: &str) -> String {
 
 fn positions(f: &Frame) -> Vec<[i64; 3]> {
     let (x, y, z) = (f.col("x").unwrap(), f.col("y").unwrap(), f.col("z").unwrap());
-    let mut v: Vec<[i64; 3]> = (0..f.natoms)
-        .map(|r| [x, y, z].map(|c| (f.get(r, c).unwrap() * 1e6).round() as i64))
-        .collect();
+    let mut v: Vec<[i64; 3]> = (0..f.natoms).map(|r| [x, y, z].map(|c| (f.get(r, c).unwrap() * 1e6).round() as i64)).collect();
     v.sort();
     v
 }

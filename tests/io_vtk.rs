@@ -2,7 +2,9 @@
 //! `dump mesh/stl` files (tests/data/io/in.liggghts), and its XML `.vtp`,
 //! `.vtu` and `.vtr` files (tests/data/io/in.liggghts_xml).
 use demx::io::dump::{BoxBounds, Frame};
-use demx::io::vtk::{format_bounding_box_vtk, format_bounding_box_vtr, format_particles_vtk, format_particles_vtk_xml, fmt_vtk_xml, format_stl, VtkFormat};
+use demx::io::vtk::{
+    fmt_vtk_xml, format_bounding_box_vtk, format_bounding_box_vtr, format_particles_vtk, format_particles_vtk_xml, format_stl, VtkFormat,
+};
 use std::collections::BTreeMap;
 
 const D: &str = "tests/data/io";
@@ -109,10 +111,8 @@ fn bounding_box_and_stl_match_liggghts() {
     let bb = std::fs::read_to_string(format!("{D}/lig_vtk_boundingBox_0.vtk")).unwrap();
     assert_eq!(format_bounding_box_vtk([-0.02, -0.02, 0.0], [0.02, 0.02, 0.04]), bb);
     // lig_tri.stl is the mesh the deck loads; LIGGGHTS dumped it as lig_mesh_3000.stl.
-    let tris = [
-        [[-0.01, -0.01, 0.001], [0.01, -0.01, 0.001], [0.01, 0.01, 0.001]],
-        [[-0.01, -0.01, 0.001], [0.01, 0.01, 0.001], [-0.01, 0.01, 0.001]],
-    ];
+    let tris =
+        [[[-0.01, -0.01, 0.001], [0.01, -0.01, 0.001], [0.01, 0.01, 0.001]], [[-0.01, -0.01, 0.001], [0.01, 0.01, 0.001], [-0.01, 0.01, 0.001]]];
     let want = std::fs::read_to_string(format!("{D}/lig_mesh_3000.stl")).unwrap();
     assert_eq!(format_stl(&tris), want);
 }
@@ -236,9 +236,14 @@ fn xml_bounding_box_matches_liggghts_but_for_array_names() {
     let want = std::fs::read_to_string(format!("{D}/lig_xml_boundingBox_1500.vtr")).unwrap();
     let got = format_bounding_box_vtr([-0.02, -0.02, 0.0], [0.02, 0.02, 0.04]);
     // VTK names the coordinate arrays after their address in memory
-    let unname = |t: &str| t.lines().map(|l| match l.split_once(" Name=\"") {
-        Some((a, b)) => format!("{a}{}", &b[b.find('"').unwrap() + 1..]),
-        None => l.to_string(),
-    }).collect::<Vec<_>>().join("\n");
+    let unname = |t: &str| {
+        t.lines()
+            .map(|l| match l.split_once(" Name=\"") {
+                Some((a, b)) => format!("{a}{}", &b[b.find('"').unwrap() + 1..]),
+                None => l.to_string(),
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
     assert_eq!(unname(&got), unname(&want));
 }

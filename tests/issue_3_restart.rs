@@ -74,10 +74,8 @@ fn killed_run_leaves_complete_frames_and_resumes_exactly() {
         assert_eq!(f.timestep, 100 * k as u64, "frames in order, none missing");
     }
     // the newest restart written before the kill
-    let mut restarts: Vec<i64> = std::fs::read_dir(d)
-        .unwrap()
-        .filter_map(|e| e.ok()?.file_name().to_str()?.strip_prefix("restart.")?.parse().ok())
-        .collect();
+    let mut restarts: Vec<i64> =
+        std::fs::read_dir(d).unwrap().filter_map(|e| e.ok()?.file_name().to_str()?.strip_prefix("restart.")?.parse().ok()).collect();
     restarts.sort();
     let last = *restarts.last().expect("a restart file was written before the kill");
     assert!(last >= 200 && last % 200 == 0, "restart step {last}");

@@ -50,10 +50,8 @@ fn legacy_deck_runs_as_its_conversion() {
     let b = demx(converted.path(), &["run", "in.converted", "--log", "none"]);
     assert_eq!(b.status.code(), Some(0), "{}", String::from_utf8_lossy(&b.stderr));
 
-    let (ours, theirs) = (
-        std::fs::read_to_string(legacy.path().join("pile.dump")).unwrap(),
-        std::fs::read_to_string(converted.path().join("pile.dump")).unwrap(),
-    );
+    let (ours, theirs) =
+        (std::fs::read_to_string(legacy.path().join("pile.dump")).unwrap(), std::fs::read_to_string(converted.path().join("pile.dump")).unwrap());
     assert_eq!(ours.matches("ITEM: TIMESTEP").count(), 4, "frames at 0, 1000, 2000, 3000");
     assert!(ours.contains("ITEM: NUMBER OF ATOMS\n60\n"), "the pack inserted its 60 grains");
     assert!(ours == theirs, "the legacy run's dump differs from the converted deck's");

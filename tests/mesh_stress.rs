@@ -36,7 +36,13 @@ fn force_and_torque_on_a_plate_follow_liggghts() {
             hits += 1;
         }
         for k in 2..11 {
-            let scale = if k < 5 { 0.1 } else if k < 8 { 1e-4 } else { 1e-3 };
+            let scale = if k < 5 {
+                0.1
+            } else if k < 8 {
+                1e-4
+            } else {
+                1e-3
+            };
             assert!((t[k] - o[k]).abs() <= 1e-12 * scale, "step {}: f_cad[{}] liggghts {} demx {}", t[0], k - 1, t[k], o[k]);
         }
     }

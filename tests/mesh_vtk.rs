@@ -33,9 +33,7 @@ enum Word {
 
 fn words(path: &Path) -> Vec<Vec<Word>> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    text.lines()
-        .map(|l| l.split_whitespace().map(|w| w.parse().map(Word::Num).unwrap_or_else(|_| Word::Text(w.to_string()))).collect())
-        .collect()
+    text.lines().map(|l| l.split_whitespace().map(|w| w.parse().map(Word::Num).unwrap_or_else(|_| Word::Text(w.to_string()))).collect()).collect()
 }
 
 /// Every line alike, word for word: text equal, and each number within
@@ -77,7 +75,11 @@ fn mesh_vtk_follows_liggghts() {
 dump c all mesh/vtk 50 c*.vtk output original {props}\ndump d all mesh/vtk 100 d*.vtk top cad vel stress id"
     );
     let (p, t) = (plate("0"), plate("0.0035"));
-    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &deck(&dumps, "dump e all mesh/vtk 50 e*.vtk stress stresscomponents vel")), ("plate.stl", &p), ("top.stl", &t)]);
+    let b = common::engine_and_demx(
+        "liggghts",
+        "in.deck",
+        &[("in.deck", &deck(&dumps, "dump e all mesh/vtk 50 e*.vtk stress stresscomponents vel")), ("plate.stl", &p), ("top.stl", &t)],
+    );
     // a grain slides on the turning plate across the run break: the
     // setup's force must leave its history as it was (a reset to the
     // setup's friction cap made the next step's tangential force 2e-6 off)

@@ -37,10 +37,7 @@ fn run_file(name: &str, vars: &[(&str, &str)]) -> Vec<Vec<f64>> {
 
 /// `S step values...` lines.
 fn rows(text: &str) -> Vec<Vec<f64>> {
-    text.lines()
-        .filter_map(|l| l.strip_prefix("S "))
-        .map(|l| l.split_whitespace().map(|w| w.parse::<f64>().expect("number")).collect())
-        .collect()
+    text.lines().filter_map(|l| l.strip_prefix("S ")).map(|l| l.split_whitespace().map(|w| w.parse::<f64>().expect("number")).collect()).collect()
 }
 
 fn reference(name: &str) -> Vec<Vec<f64>> {
@@ -85,7 +82,8 @@ fn sphere_resting_on_the_shared_edge_feels_one_hertz_contact() {
         )
     };
     let vars = [("E", "0.7"), ("X", "0.02"), ("Y", "0.02"), ("Z", "0.0049"), ("VX", "0"), ("VZ", "0")];
-    let mesh_wall = "fix cad all mesh/surface file ${DIR}/floor.stl type 1\nfix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad";
+    let mesh_wall =
+        "fix cad all mesh/surface file ${DIR}/floor.stl type 1\nfix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad";
     let prim_wall = "fix w all wall/gran model hertz tangential history primitive type 1 zplane 0.0";
     let (sm, _) = run_deck(&deck(mesh_wall), &vars);
     let (sp, _) = run_deck(&deck(prim_wall), &vars);
@@ -106,7 +104,17 @@ fn sphere_crossing_a_convex_edge_matches_liggghts() {
     // edge is active on one triangle only
     let got = run_file(
         "in.mesh",
-        &[("STL", "ridge.stl"), ("E", "0.7"), ("X", "0.001"), ("Y", "0"), ("Z", "0.03"), ("VX", "0"), ("VZ", "-0.5"), ("N", "10000"), ("EVERY", "500")],
+        &[
+            ("STL", "ridge.stl"),
+            ("E", "0.7"),
+            ("X", "0.001"),
+            ("Y", "0"),
+            ("Z", "0.03"),
+            ("VX", "0"),
+            ("VZ", "-0.5"),
+            ("N", "10000"),
+            ("EVERY", "500"),
+        ],
     );
     assert_close(&got, &reference("ref_ridge.txt"), 1e-9, "ridge vs LIGGGHTS 3.8");
 }
@@ -116,7 +124,17 @@ fn sphere_hitting_a_pyramid_apex_gains_no_energy() {
     // the apex is a node of four non-coplanar triangles: one active corner
     let got = run_file(
         "in.mesh",
-        &[("STL", "pyramid.stl"), ("E", "0.7"), ("X", "0.0003"), ("Y", "0.0002"), ("Z", "0.02"), ("VX", "0"), ("VZ", "-0.5"), ("N", "6000"), ("EVERY", "200")],
+        &[
+            ("STL", "pyramid.stl"),
+            ("E", "0.7"),
+            ("X", "0.0003"),
+            ("Y", "0.0002"),
+            ("Z", "0.02"),
+            ("VX", "0"),
+            ("VZ", "-0.5"),
+            ("N", "6000"),
+            ("EVERY", "200"),
+        ],
     );
     assert_close(&got, &reference("ref_apex.txt"), 1e-9, "apex vs LIGGGHTS 3.8");
     // translational + potential energy per unit mass before (step 800) and after (step 1400)
@@ -165,7 +183,14 @@ fn rotating_mesh_moves_its_contacts_and_dump_mesh_stl_writes_the_moved_mesh() {
     let th = 2.0 * std::f64::consts::PI * 2e-3 / 0.4;
     let (c, sn) = (th.cos(), th.sin());
     let first = [-0.05 * c + 0.05 * sn, -0.05 * sn - 0.05 * c];
-    let v: Vec<f64> = text.lines().find(|l| l.trim_start().starts_with("vertex")).expect("vertex").split_whitespace().skip(1).map(|w| w.parse().expect("num")).collect();
+    let v: Vec<f64> = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("vertex"))
+        .expect("vertex")
+        .split_whitespace()
+        .skip(1)
+        .map(|w| w.parse().expect("num"))
+        .collect();
     assert!((v[0] - first[0]).abs() < 1e-6 && (v[1] - first[1]).abs() < 1e-6, "{v:?} vs {first:?}");
     assert!(text.starts_with("solid LIGGGHTS_STL_EXPORT"));
     assert_eq!(text.matches("facet normal").count(), 2);

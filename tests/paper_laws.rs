@@ -52,7 +52,22 @@ fn pair(delta: f64, v: V3, wi: V3, wj: V3, dt: f64) -> Contact {
 /// A bead on a wall (infinite radius and mass).
 fn wall(delta: f64, v: V3, wi: V3, dt: f64) -> Contact {
     let n = V3::new(0.0, 0.0, 1.0);
-    Contact { n, r: R - delta, delta, ri: R, rj: f64::INFINITY, r_eff: R, mi: M, mj: f64::INFINITY, m_eff: M, vr: v, vn: v.dot(&n), wi, wj: V3::zeros(), dt }
+    Contact {
+        n,
+        r: R - delta,
+        delta,
+        ri: R,
+        rj: f64::INFINITY,
+        r_eff: R,
+        mi: M,
+        mj: f64::INFINITY,
+        m_eff: M,
+        vr: v,
+        vn: v.dot(&n),
+        wi,
+        wj: V3::zeros(),
+        dt,
+    }
 }
 
 fn normal_out(c: &Contact, p: &PairParams, hist: &mut [f64]) -> ContactOut {
@@ -109,7 +124,11 @@ fn collide(p: &PairParams, v: f64, on_wall: bool) -> f64 {
     let (mut delta, mut vn) = (0.0, -v);
     let mut h = [0.0];
     for _ in 0..100_000 {
-        let c = if on_wall { wall(delta, V3::new(0.0, 0.0, vn), V3::zeros(), dt) } else { pair(delta, V3::new(0.0, 0.0, vn), V3::zeros(), V3::zeros(), dt) };
+        let c = if on_wall {
+            wall(delta, V3::new(0.0, 0.0, vn), V3::zeros(), dt)
+        } else {
+            pair(delta, V3::new(0.0, 0.0, vn), V3::zeros(), V3::zeros(), dt)
+        };
         let f = if delta > 0.0 { normal_out(&c, p, &mut h).fn_total() } else { 0.0 };
         vn += f / m_eff * dt;
         delta -= vn * dt;

@@ -183,14 +183,7 @@ impl<'a, N: NormalLaw, T: TangentialLaw> Sim<'a, N, T> {
 
 /// Head-on impact starting at first touch; returns (contact duration,
 /// relative normal speed after / before, the final Sim bodies).
-fn impact<N: NormalLaw, T: TangentialLaw>(
-    n: &N,
-    t: &T,
-    p: PairParams,
-    b: Vec<Body>,
-    wall: bool,
-    dt: f64,
-) -> (f64, f64, Vec<Body>) {
+fn impact<N: NormalLaw, T: TangentialLaw>(n: &N, t: &T, p: PairParams, b: Vec<Body>, wall: bool, dt: f64) -> (f64, f64, Vec<Body>) {
     let mut s = Sim::new(n, t, p, b, wall, dt, 0.0);
     let vrel = |s: &Sim<N, T>| if s.wall { s.b[0].v.z } else { s.b[0].v.z - s.b[1].v.z };
     let v0 = vrel(&s);
@@ -213,10 +206,7 @@ fn impact<N: NormalLaw, T: TangentialLaw>(
 /// Two equal glass-like spheres (R = 1 mm) meeting head-on at relative speed v.
 fn two_spheres(v: f64) -> Vec<Body> {
     let r = 1e-3;
-    vec![
-        Body::sphere(r, V3::new(0.0, 0.0, r), V3::new(0.0, 0.0, -0.5 * v)),
-        Body::sphere(r, V3::new(0.0, 0.0, -r), V3::new(0.0, 0.0, 0.5 * v)),
-    ]
+    vec![Body::sphere(r, V3::new(0.0, 0.0, r), V3::new(0.0, 0.0, -0.5 * v)), Body::sphere(r, V3::new(0.0, 0.0, -r), V3::new(0.0, 0.0, 0.5 * v))]
 }
 
 fn hertz_tc(m: f64, r: f64, e_star: f64, v: f64) -> f64 {
@@ -292,10 +282,8 @@ fn elastic_impact_conserves_energy_and_momentum() {
     let p = liggghts(7e10, 0.25, 1.0, 0.0, 1.0);
     let (r1, r2) = (1e-3, 1.5e-3);
     let v = 2.0;
-    let b = vec![
-        Body::sphere(r1, V3::new(0.0, 0.0, r1), V3::new(0.0, 0.0, -v)),
-        Body::sphere(r2, V3::new(0.0, 0.0, -r2), V3::new(0.0, 0.0, 0.3 * v)),
-    ];
+    let b =
+        vec![Body::sphere(r1, V3::new(0.0, 0.0, r1), V3::new(0.0, 0.0, -v)), Body::sphere(r2, V3::new(0.0, 0.0, -r2), V3::new(0.0, 0.0, 0.3 * v))];
     let ke = |b: &[Body]| b.iter().map(|x| 0.5 * x.m * x.v.norm_squared()).sum::<f64>();
     let mom = |b: &[Body]| b.iter().map(|x| x.v * x.m).sum::<V3>();
     let (ke0, p0) = (ke(&b), mom(&b));
@@ -418,7 +406,8 @@ type Frames = std::collections::BTreeMap<i64, std::collections::BTreeMap<i64, Ve
 /// LIGGGHTS and by demx: their dumps (id x y z v omega), which must agree
 /// to rounding.
 fn grazing_pair(model: &str, props: &str) -> (Frames, Frames) {
-    let deck = format!("atom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
+    let deck = format!(
+        "atom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
 region reg block -0.01 0.01 -0.01 0.01 0 0.01 units box\ncreate_box 1 reg\nneighbor 0.0005 bin\nneigh_modify delay 0\n\
 fix m1 all property/global youngsModulus peratomtype 5.e6\nfix m2 all property/global poissonsRatio peratomtype 0.45\n\
 fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
@@ -429,7 +418,8 @@ set group all diameter 0.002 density 2500\ngroup a id 1\ngroup b id 2\n\
 velocity a set 1.0 0.0 -0.3 units box\nvelocity b set -1.0 0.0 -0.2 units box\nset group a omegaz 50.0\n\
 fix 1 all nve/sphere\nfix g all gravity 9.81 vector 0.0 0.0 -1.0\n\
 dump d all custom 500 dump.c id x y z vx vy vz omegax omegay omegaz\n\
-dump_modify d sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\"\nrun 4000\n");
+dump_modify d sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\"\nrun 4000\n"
+    );
     let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &deck)]);
     let (theirs, ours) = (common::dump_frames(&b.theirs.path().join("dump.c")), common::dump_frames(&b.ours.path().join("dump.c")));
     assert_eq!(theirs.keys().collect::<Vec<_>>(), ours.keys().collect::<Vec<_>>());

@@ -33,22 +33,7 @@ fn dummy_span() -> Span {
 /// Two equal spheres along z, i above j, overlap `delta`, i moving with `v`.
 fn pair(delta: f64, v: V3, wi: V3, wj: V3, dt: f64) -> Contact {
     let n = V3::new(0.0, 0.0, 1.0);
-    Contact {
-        n,
-        r: 2.0 * R - delta,
-        delta,
-        ri: R,
-        rj: R,
-        r_eff: R / 2.0,
-        mi: M,
-        mj: M,
-        m_eff: M / 2.0,
-        vr: v,
-        vn: v.dot(&n),
-        wi,
-        wj,
-        dt,
-    }
+    Contact { n, r: 2.0 * R - delta, delta, ri: R, rj: R, r_eff: R / 2.0, mi: M, mj: M, m_eff: M / 2.0, vr: v, vn: v.dot(&n), wi, wj, dt }
 }
 
 /// Sphere i resting on a wall z = 0 (n = +z).
@@ -236,8 +221,7 @@ fn lammps_granular_normal_variants() {
         assert!(rel(out.fn_elastic, 4.0 / 3.0 * e_eff * a * 1e-5) < 1e-13, "{d:?}");
         let eta = if d == GranularDamping::Tsuji {
             // alpha(0.5) from the published polynomial, evaluated by hand
-            1.2728 - 4.2783 * 0.5 + 11.087 * 0.25 - 22.348 * 0.125 + 27.467 * 0.0625 - 18.022 * 0.03125
-                + 4.8218 * 0.015625
+            1.2728 - 4.2783 * 0.5 + 11.087 * 0.25 - 22.348 * 0.125 + 27.467 * 0.0625 - 18.022 * 0.03125 + 4.8218 * 0.015625
         } else {
             0.5
         };
@@ -410,12 +394,8 @@ fn lammps_granular_history_rotation_and_rescale() {
 
 #[test]
 fn lammps_granular_mix_2021_is_geometric() {
-    let a = lammps_granular_params(
-        &granular_coeff(GranularNormal::HertzMaterial, GranularDamping::Viscoelastic, 1e7, 0.0),
-        false,
-        dummy_span(),
-    )
-    .unwrap();
+    let a =
+        lammps_granular_params(&granular_coeff(GranularNormal::HertzMaterial, GranularDamping::Viscoelastic, 1e7, 0.0), false, dummy_span()).unwrap();
     let mut gb = granular_coeff(GranularNormal::HertzMaterial, GranularDamping::Viscoelastic, 4e7, 0.0);
     gb.poisson = 0.25;
     let b = lammps_granular_params(&gb, false, dummy_span()).unwrap();

@@ -62,7 +62,14 @@ fn two_panels_give_a_png_of_two_panel_widths_with_the_series_drawn() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("out.png");
     let sq = Series { label: "square".into(), points: vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)], kind: SeriesKind::Polygon };
-    let lin = Chart { title: "geometry".into(), x_label: "x (m)".into(), y_label: "z (m)".into(), equal_aspect: true, series: vec![sq], ..Chart::default() };
+    let lin = Chart {
+        title: "geometry".into(),
+        x_label: "x (m)".into(),
+        y_label: "z (m)".into(),
+        equal_aspect: true,
+        series: vec![sq],
+        ..Chart::default()
+    };
     let decay: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, 10f64.powi(-(i as i32) / 5))).collect();
     let err = decay.iter().map(|p| 0.3 * p.1).collect();
     let log = Chart {
@@ -275,7 +282,8 @@ fn compare_and_saltation_plots() {
     assert!(blue_in(PANEL_SIZE.0, img.w) > 20, "profile markers");
     // a dump without heights has the flux panel alone
     let flat = dir.path().join("flat.dump");
-    std::fs::write(&flat, std::fs::read_to_string(&a).unwrap().replace("id type x y z vx vy vz radius mass", "id type x y zz vx vy vz radius mass")).unwrap();
+    std::fs::write(&flat, std::fs::read_to_string(&a).unwrap().replace("id type x y z vx vy vz radius mass", "id type x y zz vx vy vz radius mass"))
+        .unwrap();
     let out = dir.path().join("q1.png");
     let (code, _, stderr) = demx(&["saltation", "--plot", out.to_str().unwrap(), flat.to_str().unwrap()], &[]);
     assert_eq!(code, 0, "{stderr}");

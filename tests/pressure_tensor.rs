@@ -63,10 +63,13 @@ fn lattice_tensor_follows_lammps_on_thermo_steps_and_in_variables() {
     // and in the second run, where thermo does not read it
     let printed = |d: &std::path::Path| -> Vec<[f64; 2]> {
         let text = std::fs::read_to_string(d.join("print.txt")).expect("print.txt written");
-        text.lines().skip(1).map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
-            [v[0], v[1]]
-        }).collect()
+        text.lines()
+            .skip(1)
+            .map(|l| {
+                let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
+                [v[0], v[1]]
+            })
+            .collect()
     };
     let (a, b) = (printed(both.ours.path()), printed(both.theirs.path()));
     assert_eq!(a.len(), b.len(), "rows printed: demx {a:?} LAMMPS {b:?}");

@@ -22,12 +22,56 @@ fn thin_layer_on_the_sheet_is_blown_and_measured() {
     let d = dir.path();
     // 10 d_m x 5 d_m (multiples of the 250 um fill lattice and of the 200 um
     // sheet), delta_0 = 2 d_m on the sheet, settled briefly
-    demx(d, &["run", "in.bed.lammps", "--quiet", "-var", "delta0", "2", "-var", "sheet", "1", "-var", "lx", "0.002", "-var", "ly", "0.001", "-var", "settle", "30000", "-var", "rest", "10000"]);
+    demx(
+        d,
+        &[
+            "run",
+            "in.bed.lammps",
+            "--quiet",
+            "-var",
+            "delta0",
+            "2",
+            "-var",
+            "sheet",
+            "1",
+            "-var",
+            "lx",
+            "0.002",
+            "-var",
+            "ly",
+            "0.001",
+            "-var",
+            "settle",
+            "30000",
+            "-var",
+            "rest",
+            "10000",
+        ],
+    );
     let bed = std::fs::read_to_string(d.join("bed.data")).unwrap();
     assert!(bed.contains(" atoms"), "bed.data written");
     // 0.03 s of wind at u* = 0.5 after the kick, dumped every 0.01 s
     demx(d, &["run", "in.transport.lammps", "--quiet", "-var", "ustar", "0.5", "-var", "steps", "30000"]);
-    let out = demx(d, &["saltation", "--json", "--ustar", "0.5", "--dt", "1e-6", "--group-type", "1", "--rigid-type", "2", "--delta0", "2", "--plot", "s.png", "dump.salt"]);
+    let out = demx(
+        d,
+        &[
+            "saltation",
+            "--json",
+            "--ustar",
+            "0.5",
+            "--dt",
+            "1e-6",
+            "--group-type",
+            "1",
+            "--rigid-type",
+            "2",
+            "--delta0",
+            "2",
+            "--plot",
+            "s.png",
+            "dump.salt",
+        ],
+    );
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(j["frames"], 4, "frames at 0, 0.01, 0.02, 0.03 s");
     // the sheet's top (centres at 100 um, 200 um grains) is the rigid ground

@@ -121,7 +121,9 @@ fn jump_self_with_index_and_loop() {
     assert_eq!(h.cmds, vec!["fix fx all nve", "fix fy all nve", "fix fz all nve"]);
     assert_eq!(h.out, vec!["done"]);
     // loop 3 pad -> 1 2 3 (width of "3" is 1); loop 8 12 pad -> 08 .. 12
-    let h = run("variable L loop 3 pad\nlabel l\nprint L=${L}\nnext L\njump SELF l\nvariable M loop 8 12 pad\nlabel m\nprint M=${M}\nnext M\njump SELF m\n");
+    let h = run(
+        "variable L loop 3 pad\nlabel l\nprint L=${L}\nnext L\njump SELF l\nvariable M loop 8 12 pad\nlabel m\nprint M=${M}\nnext M\njump SELF m\n",
+    );
     assert_eq!(h.out, vec!["L=1", "L=2", "L=3", "M=08", "M=09", "M=10", "M=11", "M=12"]);
 }
 

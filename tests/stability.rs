@@ -95,7 +95,16 @@ impl Run {
         let p = self.p();
         for i in 0..p.len() {
             for v in [p.x[i], p.v[i], p.omega[i], p.f[i], p.torque[i]] {
-                assert!(v.iter().all(|c| c.is_finite()), "{}: atom {} not finite at step {}: x {:?} v {:?} f {:?}", self.name, p.tag[i], self.s.sim.step, p.x[i], p.v[i], p.f[i]);
+                assert!(
+                    v.iter().all(|c| c.is_finite()),
+                    "{}: atom {} not finite at step {}: x {:?} v {:?} f {:?}",
+                    self.name,
+                    p.tag[i],
+                    self.s.sim.step,
+                    p.x[i],
+                    p.v[i],
+                    p.f[i]
+                );
             }
         }
     }
@@ -522,7 +531,11 @@ fn paper_layer_rests_without_creep() {
             // 2.5^{2/3} = 1.84 times the static overlap)
             assert!(dxy <= 2.0 * 1.84 * delta_p, "resting layer: atom {} crept {dxy} m sideways by step {k} (bond overlap {delta_p})", p.tag[i]);
             let dz = x0.z - p.x[i].z;
-            assert!(dz >= -1e-3 * delta_w && dz <= 1.84 * delta_w + 2.0 * 1.84 * delta_p, "resting layer: atom {} sank {dz} by step {k} (delta_w {delta_w})", p.tag[i]);
+            assert!(
+                dz >= -1e-3 * delta_w && dz <= 1.84 * delta_w + 2.0 * 1.84 * delta_p,
+                "resting layer: atom {} sank {dz} by step {k} (delta_w {delta_w})",
+                p.tag[i]
+            );
         }
     }
     run.done();
@@ -713,7 +726,13 @@ fn haff_cooling_of_a_nearly_elastic_gas() {
     let pot = Potential { ys, a_h: 0.0, g: 0.0, planes: &WALLS, period: [0.0; 3] };
     let wall_energy = |run: &Run| -> f64 {
         let p = run.p();
-        (0..p.len()).map(|i| (0..3).map(|ax| hertz_energy(ys, p.radius[i], p.radius[i] - p.x[i][ax]) + hertz_energy(ys, p.radius[i], p.radius[i] - (l - p.x[i][ax]))).sum::<f64>()).sum()
+        (0..p.len())
+            .map(|i| {
+                (0..3)
+                    .map(|ax| hertz_energy(ys, p.radius[i], p.radius[i] - p.x[i][ax]) + hertz_energy(ys, p.radius[i], p.radius[i] - (l - p.x[i][ax])))
+                    .sum::<f64>()
+            })
+            .sum()
     };
     let temp = |run: &Run| -> f64 {
         let p = run.p();
@@ -757,7 +776,11 @@ fn haff_cooling_of_a_nearly_elastic_gas() {
     let tau_fit = 1.0 / slope;
     let worst = pts.iter().map(|&(t, yy)| ((icpt + slope * t) - yy).abs() / yy).fold(0.0, f64::max);
     let (tend, tt_end) = *samples.last().unwrap();
-    eprintln!("Haff gas: tau theory {tau:e} s, fit {tau_fit:e} s, intercept {icpt}, worst rel. residual {worst}, T_end/T0 {} at t/tau {}", tt_end / t0, tend / tau);
+    eprintln!(
+        "Haff gas: tau theory {tau:e} s, fit {tau_fit:e} s, intercept {icpt}, worst rel. residual {worst}, T_end/T0 {} at t/tau {}",
+        tt_end / t0,
+        tend / tau
+    );
     assert!(tt_end < 0.6 * t0, "Haff gas: did not cool: T_end/T0 = {}", tt_end / t0);
     assert!(worst < 0.03, "Haff gas: sqrt(T0/T) not linear in t: worst residual {worst}");
     assert!((icpt - 1.0).abs() < 0.03, "Haff gas: intercept {icpt}");

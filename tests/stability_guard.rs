@@ -58,12 +58,7 @@ fn hertz_time() -> f64 {
 fn run_deck(dir: &Path, name: &str, text: &str, args: &[&str]) -> Output {
     let deck = dir.join(name);
     std::fs::write(&deck, text).expect("write deck");
-    Command::new(env!("CARGO_BIN_EXE_demx"))
-        .current_dir(dir)
-        .args(args)
-        .arg(&deck)
-        .output()
-        .expect("run demx")
+    Command::new(env!("CARGO_BIN_EXE_demx")).current_dir(dir).args(args).arg(&deck).output().expect("run demx")
 }
 
 fn run(dir: &Path, text: &str) -> Output {
@@ -197,14 +192,18 @@ fn nan_from_a_variable_is_caught() {
 fn demx_guard_syntax() {
     let dir = tempfile::tempdir().expect("tempdir");
     let check = |extra: &str| run_deck(dir.path(), "in.check", &headon(1e-6, extra), &["check"]);
-    for ok in ["demx_guard overlap 0.5 travel 0.5 speed 50 every 10", "demx_guard off", "demx_guard on file none", "demx_guard speed off overlap off"] {
+    for ok in ["demx_guard overlap 0.5 travel 0.5 speed 50 every 10", "demx_guard off", "demx_guard on file none", "demx_guard speed off overlap off"]
+    {
         let o = check(ok);
         assert_eq!(o.status.code(), Some(0), "{ok}: {}", stderr(&o));
     }
     let o = check("demx_guard overlap 0.5 sped 50");
     let msg = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{msg}");
-    assert!(msg.contains("in.check:29:24: error: unknown demx_guard keyword 'sped' (expected on, off, overlap, travel, speed, every, file)"), "{msg}");
+    assert!(
+        msg.contains("in.check:29:24: error: unknown demx_guard keyword 'sped' (expected on, off, overlap, travel, speed, every, file)"),
+        "{msg}"
+    );
     assert!(msg.contains("did you mean 'speed'?"), "{msg}");
     let o = check("demx_guard every 0");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
@@ -237,7 +236,10 @@ fn wall_deck(dt: f64, z0: f64) -> String {
         .replace("set atom 1*2", "set atom 1")
         .replace("group b id 2\n", "")
         .replace("velocity b set -1.0 0.0 0.0 units box\n", "")
-        .replace("velocity a set 1.0 0.0 0.0 units box", "velocity a set 0.0 0.0 -1.0 units box\nfix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0")
+        .replace(
+            "velocity a set 1.0 0.0 0.0 units box",
+            "velocity a set 0.0 0.0 -1.0 units box\nfix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0",
+        )
 }
 
 #[test]

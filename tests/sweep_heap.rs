@@ -130,8 +130,25 @@ fn tiny_sweep_end_to_end_and_resume() {
     let p = dir.path();
     std::fs::write(p.join("in.tiny"), TINY).unwrap();
     let args = [
-        "sweep", "in.tiny", "--d", "1e-3,2e-3", "--g", "1", "--jobs", "2", "--out", "runs", "--csv", "t.csv", "--markdown", "t.md", "--plot", "t.png", "-var",
-        "N", "30",
+        "sweep",
+        "in.tiny",
+        "--d",
+        "1e-3,2e-3",
+        "--g",
+        "1",
+        "--jobs",
+        "2",
+        "--out",
+        "runs",
+        "--csv",
+        "t.csv",
+        "--markdown",
+        "t.md",
+        "--plot",
+        "t.png",
+        "-var",
+        "N",
+        "30",
     ];
     let out = demx(p, &args);
     assert!(out.status.success(), "{}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));

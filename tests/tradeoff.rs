@@ -31,16 +31,8 @@ fn tradeoff(args: &[&str]) -> (i32, String, String) {
 #[test]
 fn restitution_error_shrinks_with_the_time_step() {
     let d = deck();
-    let (code, out, err) = tradeoff(&[
-        d.to_str().unwrap(),
-        "--vary",
-        "dt_fraction=0.02,0.05,0.1,0.2",
-        "--metric",
-        "restitution",
-        "--reference",
-        "0.5",
-        "--json",
-    ]);
+    let (code, out, err) =
+        tradeoff(&[d.to_str().unwrap(), "--vary", "dt_fraction=0.02,0.05,0.1,0.2", "--metric", "restitution", "--reference", "0.5", "--json"]);
     assert_eq!(code, 0, "{out}\n{err}");
     let v: serde_json::Value = serde_json::from_str(&out).expect("json");
     let rows = v["rows"].as_array().expect("rows");

@@ -7,7 +7,6 @@
 
 mod common;
 
-
 /// 480 spheres on an fcc lattice, two types of different size and density.
 const LJ: &str = "units lj\natom_style sphere\nboundary p p f\ncomm_modify vel yes\nlattice fcc 1.0\n\
 region box block 0 6 0 5 0 4\ncreate_box 2 box\ncreate_atoms 1 region box\n\
@@ -83,7 +82,6 @@ fn rotation_zeroed_in_principal_axes_follows_lammps() {
         }
     }
 }
-
 
 #[test]
 fn bad_velocity_commands_are_deck_errors() {

@@ -78,11 +78,7 @@ fn run(neigh: &str, threads: usize) -> (Vec<u8>, u64) {
         .expect("run demx");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "demx failed: {}", String::from_utf8_lossy(&out.stderr));
-    let builds = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("Neighbor list builds = "))
-        .map(|v| v.trim().parse::<u64>().expect("build count"))
-        .sum();
+    let builds = text.lines().filter_map(|l| l.strip_prefix("Neighbor list builds = ")).map(|v| v.trim().parse::<u64>().expect("build count")).sum();
     (std::fs::read(dir.path().join("dump.spheres")).expect("dump written"), builds)
 }
 
@@ -126,7 +122,9 @@ fn lanes_change_no_bit(model: &str, what: &str) {
     // many spheres (radius 0.5 mm) press into the floor at once in some
     // frame: the batches were full
     let text = String::from_utf8_lossy(&lanes);
-    let touching = |frame: &str| frame.lines().skip(1).filter(|l| l.split_whitespace().nth(3).and_then(|z| z.parse::<f64>().ok()).is_some_and(|z| z < 0.0005)).count();
+    let touching = |frame: &str| {
+        frame.lines().skip(1).filter(|l| l.split_whitespace().nth(3).and_then(|z| z.parse::<f64>().ok()).is_some_and(|z| z < 0.0005)).count()
+    };
     let most = text.split("ITEM: ATOMS").skip(1).map(touching).max().unwrap_or(0);
     assert!(most > 50, "{what}: at most {most} spheres touch the floor at once");
     if lanes != one {

@@ -48,7 +48,8 @@ fn headon() -> Vec<[f64; 11]> {
 }
 
 fn data(spheres: &[[f64; 11]]) -> String {
-    let mut s = format!("walls\n\n{} atoms\n1 atom types\n\n-0.01 0.01 xlo xhi\n-0.01 0.01 ylo yhi\n-0.01 0.01 zlo zhi\n\nAtoms # sphere\n\n", spheres.len());
+    let mut s =
+        format!("walls\n\n{} atoms\n1 atom types\n\n-0.01 0.01 xlo xhi\n-0.01 0.01 ylo yhi\n-0.01 0.01 zlo zhi\n\nAtoms # sphere\n\n", spheres.len());
     for r in spheres {
         s += &format!("{} 1 {} 2500 {} {} {}\n", r[0], r[1], r[2], r[3], r[4]);
     }
@@ -96,7 +97,13 @@ fn run_in(dir: &Path, lmp: bool) {
     } else {
         Command::new(env!("CARGO_BIN_EXE_demx")).current_dir(dir).args(["run", "in.deck"]).output().expect("run demx")
     };
-    assert!(o.status.success(), "{} failed: {}{}", if lmp { "lmp" } else { "demx" }, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "{} failed: {}{}",
+        if lmp { "lmp" } else { "demx" },
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 /// Largest difference over all frames, atoms and columns, relative to the
@@ -312,11 +319,19 @@ fn tsuji_wall_restitution_matches_the_damped_hertz_oscillator() {
 #[test]
 fn deck_errors() {
     for (wall, code, msg) in [
-        ("wall/gran granular dmt 1e7 0.5 0.3 0.1 tangential mindlin NULL 1.0 0.5 limit_damping zplane -0.01 NULL", 2, "Cannot limit damping with DMT model"),
+        (
+            "wall/gran granular dmt 1e7 0.5 0.3 0.1 tangential mindlin NULL 1.0 0.5 limit_damping zplane -0.01 NULL",
+            2,
+            "Cannot limit damping with DMT model",
+        ),
         ("wall/gran granular hertz/material 1e7 0.5 0.3 tangential mindlin NULL 1.0 0.5", 2, "missing the wall style"),
         ("wall/gran granular tangential mindlin NULL 1.0 0.5 zplane -0.01 NULL", 2, "missing the normal model"),
         ("wall/gran granular hertz 1000 0.5 tangential mindlin NULL 1.0 0.5 zplane -0.01 NULL", 2, "kt NULL needs a material normal model"),
-        ("wall/gran granular hertz/material 1e7 0.5 0.3 tangential mindlin NULL 1.0 0.5 damping foo zplane -0.01 NULL", 2, "unknown damping model 'foo'"),
+        (
+            "wall/gran granular hertz/material 1e7 0.5 0.3 tangential mindlin NULL 1.0 0.5 damping foo zplane -0.01 NULL",
+            2,
+            "unknown damping model 'foo'",
+        ),
     ] {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("in.deck"), deck("hooke 1000 0 tangential linear_nohistory 0 0", wall, 10, false)).unwrap();

@@ -526,10 +526,8 @@ pub fn compare_series(a: &Series, b: &Series, o: &CompareOptions) -> Comparison 
         }
     }
     let peak = frames.iter().map(|f| f.a.ke + f.a.ke_rot).fold(0.0, f64::max);
-    let ke_dev = frames
-        .iter()
-        .map(|f| ((f.a.ke + f.a.ke_rot) - (f.b.ke + f.b.ke_rot)).abs() / if peak > 0.0 { peak } else { 1.0 })
-        .fold(0.0, f64::max);
+    let ke_dev =
+        frames.iter().map(|f| ((f.a.ke + f.a.ke_rot) - (f.b.ke + f.b.ke_rot)).abs() / if peak > 0.0 { peak } else { 1.0 }).fold(0.0, f64::max);
     let com_dev = frames.iter().map(|f| f.com_dev).fold(0.0, f64::max);
     let coord_dev = frames.iter().map(|f| (f.a.coordination - f.b.coordination).abs()).fold(0.0, f64::max);
     let ks_p_min = frames.iter().filter_map(|f| f.ks_p).reduce(f64::min);
@@ -742,9 +740,35 @@ pub fn write_csv(path: &Path, cs: &[Comparison]) -> Result<()> {
     let err = |e: csv::Error| Error::usage(format!("cannot write '{}': {e}", path.display()));
     let mut w = csv::Writer::from_path(path).map_err(err)?;
     w.write_record([
-        "series", "timestep", "n_a", "n_b", "matched", "pos_rms_d", "pos_max_d", "pos_max_id", "vel_rms", "vel_max", "vel_rel",
-        "omega_max", "omega_rel", "ke_a", "ke_b", "ke_rot_a", "ke_rot_b", "com_a_x", "com_a_y", "com_a_z", "com_b_x", "com_b_y",
-        "com_b_z", "com_dev_d", "coord_a", "coord_b", "ks_d", "ks_p", "exceeds",
+        "series",
+        "timestep",
+        "n_a",
+        "n_b",
+        "matched",
+        "pos_rms_d",
+        "pos_max_d",
+        "pos_max_id",
+        "vel_rms",
+        "vel_max",
+        "vel_rel",
+        "omega_max",
+        "omega_rel",
+        "ke_a",
+        "ke_b",
+        "ke_rot_a",
+        "ke_rot_b",
+        "com_a_x",
+        "com_a_y",
+        "com_a_z",
+        "com_b_x",
+        "com_b_y",
+        "com_b_z",
+        "com_dev_d",
+        "coord_a",
+        "coord_b",
+        "ks_d",
+        "ks_p",
+        "exceeds",
     ])
     .map_err(err)?;
     for c in cs {
@@ -789,10 +813,7 @@ pub fn write_csv(path: &Path, cs: &[Comparison]) -> Result<()> {
 
 /// Options of `demx compare`.
 #[derive(Parser, Debug)]
-#[command(
-    name = "demx compare",
-    about = "Compare two runs (dump files, globs, output folders), or a deck run by demx and by a reference engine"
-)]
+#[command(name = "demx compare", about = "Compare two runs (dump files, globs, output folders), or a deck run by demx and by a reference engine")]
 pub struct CompareArgs {
     /// Run A (dump, glob, folder) or a deck with --against.
     pub a: String,
@@ -942,12 +963,8 @@ pub fn charts(cs: &[Comparison]) -> Vec<crate::plot::Chart> {
         ..Chart::default()
     };
     let ke_unit = if cs.iter().any(|c| c.notes.iter().any(|n| n.contains("per unit density"))) { "J/(kg/m^3)" } else { "J" };
-    let mut ke = Chart {
-        title: "kinetic energy".into(),
-        x_label: "timestep".into(),
-        y_label: format!("translational KE ({ke_unit})"),
-        ..Chart::default()
-    };
+    let mut ke =
+        Chart { title: "kinetic energy".into(), x_label: "timestep".into(), y_label: format!("translational KE ({ke_unit})"), ..Chart::default() };
     let many = cs.len() > 1;
     let tag = |what: &str, c: &Comparison, run: &str| {
         if many {
@@ -964,10 +981,8 @@ pub fn charts(cs: &[Comparison]) -> Vec<crate::plot::Chart> {
         ke.series.push(line(tag("A", c, "A"), c.frames.iter().map(|f| (ts(f), f.a.ke)).collect()));
         ke.series.push(line(tag("B", c, "B"), c.frames.iter().map(|f| (ts(f), f.b.ke)).collect()));
     }
-    let (t0, t1) = cs
-        .iter()
-        .flat_map(|c| c.frames.iter().map(|f| f.timestep as f64))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(t), b.max(t)));
+    let (t0, t1) =
+        cs.iter().flat_map(|c| c.frames.iter().map(|f| f.timestep as f64)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(t), b.max(t)));
     if let (Some(c), true) = (cs.first(), t0 <= t1) {
         let tol = c.options.tol_pos;
         dev.series.push(Series { label: format!("tolerance {tol:e}"), points: vec![(t0, tol), (t1, tol)], kind: SeriesKind::Line });
@@ -1007,7 +1022,9 @@ fn run(args: &CompareArgs) -> Result<ExitCode> {
     };
     let code = report(args, &cs, Some(serde_json::json!({ "heap": [ha, hb], "heap_pass": heap_ok })))?;
     if !args.json {
-        let f = |h: &Option<super::compare_stats::HeapStats>| h.map_or("no heap".to_string(), |h| format!("theta_r {:.2} +- {:.2} deg, phi {:.3}, {} particles", h.theta, h.theta_sd, h.phi, h.count));
+        let f = |h: &Option<super::compare_stats::HeapStats>| {
+            h.map_or("no heap".to_string(), |h| format!("theta_r {:.2} +- {:.2} deg, phi {:.3}, {} particles", h.theta, h.theta_sd, h.phi, h.count))
+        };
         println!("heap A: {}\nheap B: {}", f(&ha), f(&hb));
         println!("heap verdict (theta_r within {} deg, phi within {}): {}", args.tol_theta, args.tol_phi, if heap_ok { "PASS" } else { "FAIL" });
     }

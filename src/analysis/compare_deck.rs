@@ -123,10 +123,7 @@ pub fn spread_checks(series: &str, per_seed: &[&Comparison], args: &CompareArgs)
         if rows.len() != per_seed.len() {
             continue;
         }
-        let peak = per_seed
-            .iter()
-            .flat_map(|c| c.frames.iter().map(|f| f.a.ke + f.a.ke_rot))
-            .fold(0.0, f64::max);
+        let peak = per_seed.iter().flat_map(|c| c.frames.iter().map(|f| f.a.ke + f.a.ke_rot)).fold(0.0, f64::max);
         let peak = if peak > 0.0 { peak } else { 1.0 };
         let mut stat = |what: &str, e: Vec<f64>, d: Vec<f64>, floor: f64| {
             let allowed = range(&e).max(range(&d)) + floor;
@@ -148,20 +145,10 @@ pub fn spread_checks(series: &str, per_seed: &[&Comparison], args: &CompareArgs)
             rows.iter().map(|r| (r.b.ke + r.b.ke_rot) / peak).collect(),
             args.tol_ke,
         );
-        stat(
-            "coordination",
-            rows.iter().map(|r| r.a.coordination).collect(),
-            rows.iter().map(|r| r.b.coordination).collect(),
-            args.tol_coord,
-        );
+        stat("coordination", rows.iter().map(|r| r.a.coordination).collect(), rows.iter().map(|r| r.b.coordination).collect(), args.tol_coord);
         // centre of mass per component; the fixed tolerance is in mean diameters
         for (k, axis) in ["com x", "com y", "com z"].iter().enumerate() {
-            stat(
-                axis,
-                rows.iter().map(|r| r.a.com[k]).collect(),
-                rows.iter().map(|r| r.b.com[k]).collect(),
-                args.tol_com * dmean,
-            );
+            stat(axis, rows.iter().map(|r| r.a.com[k]).collect(), rows.iter().map(|r| r.b.com[k]).collect(), args.tol_com * dmean);
         }
     }
     out
@@ -217,7 +204,15 @@ pub fn heap_checks(rows: &[HeapRow], args: &CompareArgs) -> Vec<SpreadCheck> {
         let d: Vec<f64> = pairs.iter().map(|p| f(&p.1)).collect();
         let allowed = range(&e).max(range(&d)) + floor;
         let (me, md) = (mean(&e), mean(&d));
-        out.push(SpreadCheck { series: "heap".into(), what: what.into(), timestep: 0, demx_mean: md, engine_mean: me, allowed, pass: (md - me).abs() <= allowed });
+        out.push(SpreadCheck {
+            series: "heap".into(),
+            what: what.into(),
+            timestep: 0,
+            demx_mean: md,
+            engine_mean: me,
+            allowed,
+            pass: (md - me).abs() <= allowed,
+        });
     };
     stat("heap count", &|h| h.count as f64, 0.0);
     stat("theta_r (deg)", &|h| h.theta, args.tol_theta);
@@ -337,7 +332,11 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode> {
             println!("  demx ensemble member {}: {:.2} s", m + 1, r.wall_seconds);
         }
         for h in &heaps {
-            let f = |x: &Option<HeapStats>| x.map_or("no heap".to_string(), |h| format!("theta_r {:.2} +- {:.2} deg, phi {:.3}, {} particles", h.theta, h.theta_sd, h.phi, h.count));
+            let f = |x: &Option<HeapStats>| {
+                x.map_or("no heap".to_string(), |h| {
+                    format!("theta_r {:.2} +- {:.2} deg, phi {:.3}, {} particles", h.theta, h.theta_sd, h.phi, h.count)
+                })
+            };
             println!("  heap{}: {}: {}; demx: {}", h.seed.map_or(String::new(), |s| format!(" (seed {s})")), engine.name(), f(&h.engine), f(&h.demx));
         }
         for n in &prep.notes {
@@ -368,7 +367,12 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode> {
         }
         for c in &comparisons {
             if let Some((t, id, e)) = c.divergence {
-                println!("{} vs {}: trajectories diverge at timestep {t} (particle {}, {e:.3e} d)", c.a, c.b, id.map_or("?".to_string(), |i| i.to_string()));
+                println!(
+                    "{} vs {}: trajectories diverge at timestep {t} (particle {}, {e:.3e} d)",
+                    c.a,
+                    c.b,
+                    id.map_or("?".to_string(), |i| i.to_string())
+                );
             }
         }
         let last = spread.iter().filter(|s| s.series != "heap").map(|s| s.timestep).max();

@@ -186,8 +186,7 @@ fn format_lines(id: &str, dumps: &std::collections::HashMap<String, (bool, Optio
 /// python/...`, also inside `if ... then "..."`) is refused before any
 /// engine starts: the engine would run them before demx read the deck.
 pub fn prepare_deck(deck: &Path, engine: RefEngine, allow_shell: bool) -> Result<PreparedDeck> {
-    let text = std::fs::read_to_string(deck)
-        .map_err(|e| Error::io(Span::DUMMY, format!("cannot read deck '{}'", deck.display()), &e))?;
+    let text = std::fs::read_to_string(deck).map_err(|e| Error::io(Span::DUMMY, format!("cannot read deck '{}'", deck.display()), &e))?;
     if !allow_shell {
         refuse_system_commands(deck, &text, engine)?;
     }
@@ -256,7 +255,8 @@ fn refuse_system_commands(path: &Path, text: &str, engine: RefEngine) -> Result<
         let hit = ws.first().is_some_and(|w| if w == "shell" { runs(&whole) } else { runs(w) })
             || ws.iter().skip(1).any(|w| w == "python" || w.starts_with("python/") || (w.contains(' ') && runs(w)));
         if hit {
-            let what = ws.iter().find(|w| w.split_whitespace().next().is_some_and(|c| c == "shell" || c.starts_with("python"))).cloned().unwrap_or_default();
+            let what =
+                ws.iter().find(|w| w.split_whitespace().next().is_some_and(|c| c == "shell" || c.starts_with("python"))).cloned().unwrap_or_default();
             let col = line.find(what.split_whitespace().next().unwrap_or("")).map_or(1, |c| c + 1);
             let kind = if what.starts_with("shell") { "a system command (shell)" } else { "Python code" };
             return Err(Error::usage(format!(
@@ -302,11 +302,7 @@ pub struct EngineResult {
 }
 
 fn is_openmpi() -> bool {
-    Command::new("mpirun")
-        .arg("--version")
-        .output()
-        .map(|o| String::from_utf8_lossy(&o.stdout).contains("Open MPI"))
-        .unwrap_or(false)
+    Command::new("mpirun").arg("--version").output().map(|o| String::from_utf8_lossy(&o.stdout).contains("Open MPI")).unwrap_or(false)
 }
 
 /// Last `n` lines of a text.
@@ -370,19 +366,10 @@ pub fn run_engine(dir: &Path, deck_name: &str, run: &EngineRun) -> Result<Engine
     }
     let command = argv.iter().map(|a| if a.contains(' ') { format!("'{a}'") } else { a.clone() }).collect::<Vec<_>>().join(" ");
     let screen = dir.join("screen.txt");
-    let out_file = std::fs::File::create(&screen)
-        .map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", screen.display()), &e))?;
-    let err_file = out_file
-        .try_clone()
-        .map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", screen.display()), &e))?;
+    let out_file = std::fs::File::create(&screen).map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", screen.display()), &e))?;
+    let err_file = out_file.try_clone().map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", screen.display()), &e))?;
     let t0 = Instant::now();
-    let status = Command::new(&argv[0])
-        .args(&argv[1..])
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(out_file)
-        .stderr(err_file)
-        .status();
+    let status = Command::new(&argv[0]).args(&argv[1..]).current_dir(dir).stdin(Stdio::null()).stdout(out_file).stderr(err_file).status();
     let wall_seconds = t0.elapsed().as_secs_f64();
     let status = match status {
         Ok(s) => s,

@@ -269,11 +269,7 @@ pub fn charts(xz: &Profile, yz: &Profile) -> Vec<crate::plot::Chart> {
                 equal_aspect: true,
                 series: vec![
                     Series { label: "upper boundary".into(), points: boundary, kind: SeriesKind::Line },
-                    Series {
-                        label: format!("triangle, same area (B = {:.3e} m)", p.base),
-                        points: p.triangle().to_vec(),
-                        kind: SeriesKind::Polygon,
-                    },
+                    Series { label: format!("triangle, same area (B = {:.3e} m)", p.base), points: p.triangle().to_vec(), kind: SeriesKind::Polygon },
                 ],
                 ..Chart::default()
             }

@@ -586,7 +586,11 @@ fn profile_chart(a: &Analysis, s: &Settings) -> crate::plot::Chart {
             let z = s.fit_from + (zmax - s.fit_from) * k as f64 / 50.0;
             (z, n0 * (-z * s.d_m / l).exp())
         });
-        series.push(Series { label: format!("Eq. 17 fit, l_nu = {:.2} d_m ({:.0}-{:.0} d_m)", l / s.d_m, s.fit_from, zmax), points: fit.collect(), kind: SeriesKind::Line });
+        series.push(Series {
+            label: format!("Eq. 17 fit, l_nu = {:.2} d_m ({:.0}-{:.0} d_m)", l / s.d_m, s.fit_from, zmax),
+            points: fit.collect(),
+            kind: SeriesKind::Line,
+        });
     }
     Chart {
         title: "concentration above the bed".into(),

@@ -512,7 +512,11 @@ pub fn markdown(runs: &[RunResult], failed: &[String], f: &Fits) -> String {
     }
     for (g, e) in &f.eq1 {
         let paper_d = PAPER_DE / g.sqrt();
-        s += &format!("| Eq. 1 (g/g_E = {g}) | μ_eff,∞ | {}{} | {PAPER_MU} |\n", pm(e.mu, e.mu_se, 1.0, 3), if e.mu_se == 0.0 { " (fixed)" } else { "" });
+        s += &format!(
+            "| Eq. 1 (g/g_E = {g}) | μ_eff,∞ | {}{} | {PAPER_MU} |\n",
+            pm(e.mu, e.mu_se, 1.0, 3),
+            if e.mu_se == 0.0 { " (fixed)" } else { "" }
+        );
         s += &format!("| Eq. 1 (g/g_E = {g}) | D (µm) | {} | {:.1} (Eq. 2) |\n", pm(e.c, e.c_se, 1e6, 1), paper_d * 1e6);
     }
     if let Some((d0, sd0, a, sa)) = f.power {
@@ -607,7 +611,13 @@ pub fn cli(args: Vec<String>) -> ExitCode {
     ok &= write(&c.out.join("fits.csv"), &fits_csv(&fits));
     print!("{}", csv_table(&runs));
     if let Some(e) = &fits.eq3 {
-        println!("Eq. 3: mu_eff,inf = {}, D_E = {} um (R^2 {:.3}); paper {PAPER_MU}, {} um", pm(e.mu, e.mu_se, 1.0, 4), pm(e.c, e.c_se, 1e6, 2), e.r2, PAPER_DE * 1e6);
+        println!(
+            "Eq. 3: mu_eff,inf = {}, D_E = {} um (R^2 {:.3}); paper {PAPER_MU}, {} um",
+            pm(e.mu, e.mu_se, 1.0, 4),
+            pm(e.c, e.c_se, 1e6, 2),
+            e.r2,
+            PAPER_DE * 1e6
+        );
     }
     for (g, e) in &fits.eq1 {
         println!("Eq. 1, g/g_E = {g}: mu_eff,inf = {}, D = {} um", pm(e.mu, e.mu_se, 1.0, 4), pm(e.c, e.c_se, 1e6, 2));

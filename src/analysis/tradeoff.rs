@@ -131,7 +131,10 @@ impl Metric {
 
 /// Arguments of `demx tradeoff`.
 #[derive(clap::Parser, Debug)]
-#[command(name = "demx tradeoff", about = "What accuracy costs in time: run a deck over a grid of settings (and seeds) and report metric, error and wall time")]
+#[command(
+    name = "demx tradeoff",
+    about = "What accuracy costs in time: run a deck over a grid of settings (and seeds) and report metric, error and wall time"
+)]
 pub struct TradeoffArgs {
     /// The deck.
     pub deck: PathBuf,
@@ -360,7 +363,10 @@ pub fn thermo_column(log: &str, name: &str) -> Vec<f64> {
 pub fn restitution(first: &Frame, last: &Frame) -> Result<f64> {
     let vn = |f: &Frame| -> Result<f64> {
         if f.natoms != 2 {
-            return Err(Error::usage(format!("restitution needs a two-particle deck; the dump frame at step {} has {} particles", f.timestep, f.natoms)));
+            return Err(Error::usage(format!(
+                "restitution needs a two-particle deck; the dump frame at step {} has {} particles",
+                f.timestep, f.natoms
+            )));
         }
         let [x, y, z] = super::repose::positions(f)?;
         let get = |n: &str| f.column(n).ok_or_else(|| Error::usage(format!("restitution needs vx vy vz in the dump (missing {n})")));
@@ -484,8 +490,15 @@ fn logged_timestep(dir: &Path) -> Option<f64> {
 }
 
 /// Run `demx run` in `dir`; Ok(wall seconds) or the failure text.
-fn run_one(dir: &Path, deck_name: &str, setting: &[(Param, String)], vars: &[(String, Vec<String>)], threads: usize) -> Result<std::result::Result<f64, String>> {
-    let mut args: Vec<String> = vec!["run".into(), "--quiet".into(), "--log".into(), "log.demx".into(), "--threads".into(), threads.max(1).to_string()];
+fn run_one(
+    dir: &Path,
+    deck_name: &str,
+    setting: &[(Param, String)],
+    vars: &[(String, Vec<String>)],
+    threads: usize,
+) -> Result<std::result::Result<f64, String>> {
+    let mut args: Vec<String> =
+        vec!["run".into(), "--quiet".into(), "--log".into(), "log.demx".into(), "--threads".into(), threads.max(1).to_string()];
     for (p, v) in setting {
         match p {
             Param::DtFraction => args.extend(["--dt-fraction".to_string(), v.clone()]),
@@ -637,7 +650,10 @@ pub fn render(t: &Tradeoff) -> String {
     let mut o = String::new();
     o.push_str(&format!("deck: {}   metric: {}   reference: {} = {}\n", t.deck, t.metric.label(), t.reference, num(t.reference_value, 6)));
     let w = t.rows.iter().map(|r| r.label.len()).max().unwrap_or(7).max(7);
-    o.push_str(&format!("{:<w$}  {:>22}  {:>11}  {:>9}  {:>11}  {:>9}  {:>8}\n", "setting", "metric (mean +- SD)", "|error|", "rel", "wall (s)", "speed-up", "dt (s)"));
+    o.push_str(&format!(
+        "{:<w$}  {:>22}  {:>11}  {:>9}  {:>11}  {:>9}  {:>8}\n",
+        "setting", "metric (mean +- SD)", "|error|", "rel", "wall (s)", "speed-up", "dt (s)"
+    ));
     for r in &t.rows {
         let m = if r.n > 0 { format!("{} +- {}", num(r.mean, 5), num(r.sd, 5)) } else { "FAILED".to_string() };
         o.push_str(&format!(

@@ -273,10 +273,8 @@ fn legacy_in_memory(sources: &SourceMap, path: &std::path::Path, text: &str) -> 
         let id = sources.add(path.to_path_buf(), text.to_string());
         let span = crate::script::Span::new(id, start + indent, start + line.trim_end().len().max(indent + 1));
         let msg = format!("running this LIGGGHTS 1.x/2.x line (its conversion to 3.x would be approximate: {})", n.message);
-        return Err(Error::unsupported(span, msg).with_hint(format!(
-            "`demx convert {} --to liggghts` writes the 3.x deck with its notes, to edit and run",
-            path.display()
-        )));
+        return Err(Error::unsupported(span, msg)
+            .with_hint(format!("`demx convert {} --to liggghts` writes the 3.x deck with its notes, to edit and run", path.display())));
     }
     Ok(c.text)
 }

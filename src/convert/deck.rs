@@ -117,15 +117,7 @@ pub fn logical_lines(src: &str) -> Vec<Logical> {
 }
 
 fn unreachable_logical(line: usize, offset: usize) -> Logical {
-    Logical {
-        line,
-        offset,
-        physical: Vec::new(),
-        eol: String::new(),
-        indent: String::new(),
-        command: String::new(),
-        comment: None,
-    }
+    Logical { line, offset, physical: Vec::new(), eol: String::new(), indent: String::new(), command: String::new(), comment: None }
 }
 
 /// Split at the first `#` outside quotes.

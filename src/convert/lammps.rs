@@ -169,7 +169,11 @@ fn granular_coeffs(ctx: &mut Ctx, m: &Model3, i: usize, j: usize, wall: bool) ->
             let mu = f.pair_value("coefficientFriction", i, j)?;
             let normal = if m.normal == "hooke/stiffness" { "hooke" } else { "hertz" };
             let xgt = if gn != 0.0 { gt / gn } else { 0.0 };
-            let tang = if m.tangential == "no_history" { format!("linear_nohistory {} {}", fmt(xgt), fmt(mu)) } else { format!("linear_history {} {} {}", fmt(kt), fmt(xgt), fmt(mu)) };
+            let tang = if m.tangential == "no_history" {
+                format!("linear_nohistory {} {}", fmt(xgt), fmt(mu))
+            } else {
+                format!("linear_history {} {} {}", fmt(kt), fmt(xgt), fmt(mu))
+            };
             Some(format!("{normal} {} {} tangential {tang} damping mass_velocity", fmt(kn), fmt(gn)))
         }
         _ => None,
@@ -323,7 +327,12 @@ pub fn pair_coeff_to_lammps(ctx: &mut Ctx, _w: &[String]) -> Option<Action> {
         for j in i..=n {
             match granular_coeffs(ctx, &m, i, j, false) {
                 Some(c) => lines.push(format!("pair_coeff {i} {j} {c}")),
-                None => return Some(Action::Drop(format!("model {} or its material properties (constant numbers) not convertible", m.normal), Severity::Dropped)),
+                None => {
+                    return Some(Action::Drop(
+                        format!("model {} or its material properties (constant numbers) not convertible", m.normal),
+                        Severity::Dropped,
+                    ))
+                }
             }
         }
     }
@@ -354,7 +363,8 @@ fn wall_coeffs(ctx: &mut Ctx, m: &Model3, t: usize) -> Option<String> {
 /// `gran/hooke/history` or `gran/hertz/history` (any other pair style
 /// forgets it), for the 2012-era walls after it ([`legacy_wall_to_lammps`]).
 pub fn note_classic_style(ctx: &mut Ctx, w: &[String]) {
-    ctx.legacy_wall_style = w.get(1).and_then(|s| s.strip_prefix("gran/")).filter(|s| matches!(*s, "hooke" | "hooke/history" | "hertz/history")).map(str::to_string);
+    ctx.legacy_wall_style =
+        w.get(1).and_then(|s| s.strip_prefix("gran/")).filter(|s| matches!(*s, "hooke" | "hooke/history" | "hertz/history")).map(str::to_string);
 }
 
 /// 2012-era LAMMPS `fix ID G wall/gran Kn Kt gn gt xmu dampflag wallstyle
@@ -513,7 +523,9 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
         ctx.note(Severity::Approx, "templates of different densities: fix pour draws density uniformly in their range".into());
     }
     let vel = match w.iter().position(|x| x == "vel") {
-        Some(i) if w.get(i + 1).map(|s| s.as_str()) == Some("constant") => w.get(i + 2..i + 5).map(|v| format!("vel {} {} {} {} {}", v[0], v[0], v[1], v[1], v[2])),
+        Some(i) if w.get(i + 1).map(|s| s.as_str()) == Some("constant") => {
+            w.get(i + 2..i + 5).map(|v| format!("vel {} {} {} {} {}", v[0], v[0], v[1], v[1], v[2]))
+        }
         _ => None,
     }
     .unwrap_or_default();
@@ -591,7 +603,14 @@ pub fn insert_to_pour(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
             };
             (fmt(n), one_batch_fraction(t, n, vp, vol_now))
         }
-        (Some(t), false) if sizes.len() == 1 && pair_before && !referenced_later && every.as_deref().and_then(|e| f.num(e)).is_some_and(|e| e >= 1.0) && insertions_until_unfix(ctx, id, 1).is_some() && per_insert(t).is_some() => {
+        (Some(t), false)
+            if sizes.len() == 1
+                && pair_before
+                && !referenced_later
+                && every.as_deref().and_then(|e| f.num(e)).is_some_and(|e| e >= 1.0)
+                && insertions_until_unfix(ctx, id, 1).is_some()
+                && per_insert(t).is_some() =>
+        {
             let e = every.as_deref().and_then(|e| f.num(e)).unwrap_or(1.0) as u64;
             let n = per_insert(t).unwrap_or_default();
             if let Some(a) = pack_every_rsa(ctx, id, &region, &n, &ty, &seed, sizes[0].0, dlo, w, e) {
@@ -759,7 +778,17 @@ impl InsertSchedule {
 
 /// The packing block of an insert fix, and the lines that define the region
 /// its centres go in (shrunk by the radius for `all_in yes`, box units).
-fn rsa_setup(ctx: &Ctx, k: usize, region: &str, per_insert: &str, ty: &str, seed: &str, diam: f64, dens: f64, w: &[String]) -> (Vec<String>, RsaBlock) {
+fn rsa_setup(
+    ctx: &Ctx,
+    k: usize,
+    region: &str,
+    per_insert: &str,
+    ty: &str,
+    seed: &str,
+    diam: f64,
+    dens: f64,
+    w: &[String],
+) -> (Vec<String>, RsaBlock) {
     let f = ctx.facts;
     let get = |key: &str| w.iter().position(|x| x == key).and_then(|i| w.get(i + 1)).cloned();
     let vel = match w.iter().position(|x| x == "vel") {
@@ -773,7 +802,9 @@ fn rsa_setup(ctx: &Ctx, k: usize, region: &str, per_insert: &str, ty: &str, seed
         if let Some(rd) = f.regions.get(region).filter(|rd| rd.args.windows(2).any(|p| p[0] == "units" && p[1] == "box")) {
             let sh = fmt(r);
             let b: Option<Vec<String>> = match rd.style.as_str() {
-                "block" if rd.args.len() >= 6 => Some((0..6).map(|i| format!("({}){}{sh}", rd.args[i], if i % 2 == 0 { "+" } else { "-" })).collect()),
+                "block" if rd.args.len() >= 6 => {
+                    Some((0..6).map(|i| format!("({}){}{sh}", rd.args[i], if i % 2 == 0 { "+" } else { "-" })).collect())
+                }
                 "cylinder" if rd.args.len() >= 6 => Some(vec![
                     rd.args[0].clone(),
                     format!("({})", rd.args[1]),
@@ -832,7 +863,18 @@ fn pack_once_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &s
 /// are constants: a packing pass now (LIGGGHTS inserts on the next step),
 /// and one at every E-th step after, by splitting the runs that follow until
 /// `unfix` (see `split_run`).
-fn pack_every_rsa(ctx: &mut Ctx, id: &str, region: &str, per_insert: &str, ty: &str, seed: &str, diam: f64, dens: f64, w: &[String], every: u64) -> Option<Action> {
+fn pack_every_rsa(
+    ctx: &mut Ctx,
+    id: &str,
+    region: &str,
+    per_insert: &str,
+    ty: &str,
+    seed: &str,
+    diam: f64,
+    dens: f64,
+    w: &[String],
+    every: u64,
+) -> Option<Action> {
     let now = steps_before(ctx, ctx.pos)?;
     let k = ctx.inserts_seen;
     let (mut lines, block) = rsa_setup(ctx, k, region, per_insert, ty, seed, diam, dens, w);
@@ -885,7 +927,10 @@ pub fn split_run(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     let mut cur = start;
     loop {
         // the earliest pending insertion inside (cur, end]
-        let Some(k) = (0..ctx.insert_schedules.len()).filter(|&k| ctx.insert_schedules[k].next <= end).min_by_key(|&k| ctx.insert_schedules[k].next) else { break };
+        let Some(k) = (0..ctx.insert_schedules.len()).filter(|&k| ctx.insert_schedules[k].next <= end).min_by_key(|&k| ctx.insert_schedules[k].next)
+        else {
+            break;
+        };
         let at = ctx.insert_schedules[k].next;
         // LIGGGHTS inserts at the start of step `at`: after step at - 1
         if at > cur + 1 {
@@ -1149,7 +1194,10 @@ pub fn wall_to_liggghts(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     let Some((normal, tang)) = ctx.liggghts_walls.clone() else {
         return Some(Action::Drop("wall/gran before a convertible pair style".into(), Severity::Dropped));
     };
-    ctx.note(Severity::Info, format!("wall {id} uses the pair materials of type 1 (LIGGGHTS primitive type 1); wall values written in the LAMMPS line are not re-read"));
+    ctx.note(
+        Severity::Info,
+        format!("wall {id} uses the pair materials of type 1 (LIGGGHTS primitive type 1); wall values written in the LAMMPS line are not re-read"),
+    );
     let block = format!("model {normal} tangential {tang}");
     let geom = w[gpos].as_str();
     let extra = w.get(gpos + if geom == "zcylinder" { 2 } else { 3 }..).unwrap_or(&[]);

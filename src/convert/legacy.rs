@@ -14,8 +14,16 @@ fn legacy_model(style: &str) -> Option<(&'static str, &'static str, Option<&'sta
         "gran/hooke/history" => ("hooke", "history", None),
         "gran/hooke" => ("hooke", "no_history", None),
         "gran/hertz" => ("hertz", "no_history", None),
-        "gran/hooke/history/simple" => ("hooke/stiffness", "history", Some("2.x '/simple' styles took kn, kt, gamman, gammat; mapped to hooke/stiffness (damping x m*): check the damping convention")),
-        "gran/hertz/history/simple" => ("hertz/stiffness", "history", Some("2.x '/simple' styles took kn, kt, gamman, gammat; mapped to hertz/stiffness: check the damping convention")),
+        "gran/hooke/history/simple" => (
+            "hooke/stiffness",
+            "history",
+            Some("2.x '/simple' styles took kn, kt, gamman, gammat; mapped to hooke/stiffness (damping x m*): check the damping convention"),
+        ),
+        "gran/hertz/history/simple" => (
+            "hertz/stiffness",
+            "history",
+            Some("2.x '/simple' styles took kn, kt, gamman, gammat; mapped to hertz/stiffness: check the damping convention"),
+        ),
         "gran/hooke/history/hysteresis" => ("hooke/hysteresis", "history", None),
         _ => return None,
     })
@@ -89,7 +97,17 @@ fn model_keywords(rest: &[String], m: &mut Model) -> Vec<String> {
                 m.rolling = Some(rest[i + 1].clone());
                 i += 2;
             }
-            "tangential_damping" | "limitForce" | "computeDissipatedEnergy" | "computeElasticPotential" | "heating_normal_hertz" | "ktToKnUser" | "absolute_damping" | "tangential_reduce" | "torsionTorque" if i + 1 < rest.len() => {
+            "tangential_damping"
+            | "limitForce"
+            | "computeDissipatedEnergy"
+            | "computeElasticPotential"
+            | "heating_normal_hertz"
+            | "ktToKnUser"
+            | "absolute_damping"
+            | "tangential_reduce"
+            | "torsionTorque"
+                if i + 1 < rest.len() =>
+            {
                 m.keywords.push(format!("{} {}", rest[i], rest[i + 1]));
                 i += 2;
             }
@@ -186,8 +204,9 @@ pub fn mesh(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
             let ty = w.get(5)?;
             let nums: Vec<Option<f64>> = w.iter().skip(6).take(7).map(|x| ctx.facts.num(x)).collect();
             if nums.len() < 7 || nums.iter().any(|x| x.is_none()) {
-                return Some(Action::Replace(vec![format!("fix {id} {group} mesh/surface file {file} type {ty}")]))
-                    .inspect(|_| ctx.note(Severity::Approx, "mesh/gran transform values not all constant numbers; scale/offset/rotation dropped".into()));
+                return Some(Action::Replace(vec![format!("fix {id} {group} mesh/surface file {file} type {ty}")])).inspect(|_| {
+                    ctx.note(Severity::Approx, "mesh/gran transform values not all constant numbers; scale/offset/rotation dropped".into())
+                });
             }
             let v: Vec<f64> = nums.into_iter().flatten().collect();
             let mut s = format!("fix {id} {group} mesh/surface file {file} type {ty}");
@@ -383,7 +402,10 @@ pub fn pour_to_insert(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
             for k in 0..nb {
                 sizes.push((lo + (k as f64 + 0.5) / nb as f64 * (hi - lo), 1.0 / nb as f64));
             }
-            ctx.note(Severity::Approx, format!("uniform diameters {lo}..{hi} discretised into {nb} equal-number sizes (LIGGGHTS 3.x templates take one radius each)"));
+            ctx.note(
+                Severity::Approx,
+                format!("uniform diameters {lo}..{hi} discretised into {nb} equal-number sizes (LIGGGHTS 3.x templates take one radius each)"),
+            );
         }
     } else {
         for (d, q) in &p.poly {
@@ -417,7 +439,12 @@ pub fn pour_to_insert(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     for (k, (d, _)) in sizes.iter().enumerate() {
         let tid = if sizes.len() == 1 { format!("{id}_pts") } else { format!("{id}_pts{}", k + 1) };
         let seed = ctx.new_seed();
-        lines.push(format!("fix {tid} {group} particletemplate/sphere {seed} atom_type {} density constant {} radius constant {}", p.ty, fmt(dens), fmt(d / 2.0)));
+        lines.push(format!(
+            "fix {tid} {group} particletemplate/sphere {seed} atom_type {} density constant {} radius constant {}",
+            p.ty,
+            fmt(dens),
+            fmt(d / 2.0)
+        ));
         tmpl.push(format!("{tid} {}", fmt(masses[k] / msum)));
     }
     let seed = ctx.new_seed();
@@ -439,7 +466,10 @@ pub fn pour_to_insert(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
             (k, b / (k as f64 * dt))
         }
         _ => {
-            ctx.note(Severity::Approx, "pour batch size or interval unknown (region, gravity or timestep not constant): insert_every 1000 with 1 particle per step".into());
+            ctx.note(
+                Severity::Approx,
+                "pour batch size or interval unknown (region, gravity or timestep not constant): insert_every 1000 with 1 particle per step".into(),
+            );
             (1000, 1.0 / f.dt.unwrap_or(1.0))
         }
     };

@@ -191,7 +191,11 @@ fn legacy_rules(ctx: &mut Ctx, w: &[String], to: Target) -> Action {
         "pair_style" => legacy::pair_style(ctx, w),
         "dump" => legacy::dump(ctx, w),
         "unfix" if w.len() == 2 => ctx.split_ids.get(&w[1]).map(|ids| Action::Replace(ids.iter().map(|i| format!("unfix {i}")).collect())),
-        "set" if w.iter().any(|x| x == "property/peratom") => Some(Action::Replace(vec![w.iter().map(|x| if x == "property/peratom" { "property/atom" } else { x.as_str() }).collect::<Vec<_>>().join(" ")])),
+        "set" if w.iter().any(|x| x == "property/peratom") => Some(Action::Replace(vec![w
+            .iter()
+            .map(|x| if x == "property/peratom" { "property/atom" } else { x.as_str() })
+            .collect::<Vec<_>>()
+            .join(" ")])),
         "fix" if w.len() >= 4 => {
             let style = w[3].as_str();
             if style.starts_with("wall/gran/") && style != "wall/gran/region" {
@@ -219,21 +223,14 @@ fn legacy_rules(ctx: &mut Ctx, w: &[String], to: Target) -> Action {
     r.unwrap_or(Action::Keep)
 }
 
-const MATERIALS: &[&str] = &[
-    "youngsModulus",
-    "poissonsRatio",
-    "coefficientRestitution",
-    "coefficientFriction",
-    "kn",
-    "kt",
-    "gamman",
-    "gammat",
-    "characteristicVelocity",
-];
+const MATERIALS: &[&str] =
+    &["youngsModulus", "poissonsRatio", "coefficientRestitution", "coefficientFriction", "kn", "kt", "gamman", "gammat", "characteristicVelocity"];
 
 /// References to dropped fixes (`f_ID`, `f_ID[i]`).
 fn refs_dropped(ctx: &Ctx, word: &str) -> bool {
-    word.strip_prefix("f_").map(|r| r.split('[').next().unwrap_or(r)).is_some_and(|id| ctx.dropped_fixes.contains(id) || !ctx.facts.fix_ids.contains(id))
+    word.strip_prefix("f_")
+        .map(|r| r.split('[').next().unwrap_or(r))
+        .is_some_and(|id| ctx.dropped_fixes.contains(id) || !ctx.facts.fix_ids.contains(id))
 }
 
 /// `f_ID[1]` of an insertion fix that became `fix pour` (which has no
@@ -273,9 +270,14 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
         };
     }
     let r = match w[0].as_str() {
-        "atom_style" if w.get(1).map(|s| s.as_str()) == Some("granular") => Some(Action::Replace(vec![if ctx.facts.has_adapt { "atom_style sphere 1".into() } else { "atom_style sphere".into() }])),
+        "atom_style" if w.get(1).map(|s| s.as_str()) == Some("granular") => {
+            Some(Action::Replace(vec![if ctx.facts.has_adapt { "atom_style sphere 1".into() } else { "atom_style sphere".into() }]))
+        }
         "atom_modify" if ctx.facts.has_insertion && w.windows(2).any(|p| p[0] == "map" && p[1] == "array") => {
-            ctx.note(Severity::Info, "atom_modify map array -> map hash: LAMMPS 29Sep2021 fix pour segfaults in Atom::map_set with map array (observed)".into());
+            ctx.note(
+                Severity::Info,
+                "atom_modify map array -> map hash: LAMMPS 29Sep2021 fix pour segfaults in Atom::map_set with map array (observed)".into(),
+            );
             Some(Action::Replace(vec![w.iter().map(|x| if x == "array" { "hash" } else { x.as_str() }).collect::<Vec<_>>().join(" ")]))
         }
         "run" if !ctx.insert_schedules.is_empty() => lammps::split_run(ctx, w).or_else(|| {
@@ -292,17 +294,25 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
             Some(Action::Replace(v))
         }
         // LIGGGHTS (old LAMMPS) takes the whole-line format string
-        "dump_modify" if w.get(2).map(|s| s.as_str()) == Some("format") && w.get(3).is_some_and(|x| !matches!(x.as_str(), "line" | "int" | "float" | "none")) => {
+        "dump_modify"
+            if w.get(2).map(|s| s.as_str()) == Some("format")
+                && w.get(3).is_some_and(|x| !matches!(x.as_str(), "line" | "int" | "float" | "none")) =>
+        {
             let mut v = w.to_vec();
             v.insert(3, "line".into());
             Some(Action::Replace(vec![v.join(" ")]))
         }
-        "hard_particles" | "soft_particles" => Some(Action::Drop(format!("{}: a LIGGGHTS switch for large overlaps; LAMMPS has none", w[0]), Severity::Info)),
+        "hard_particles" | "soft_particles" => {
+            Some(Action::Drop(format!("{}: a LIGGGHTS switch for large overlaps; LAMMPS has none", w[0]), Severity::Info))
+        }
         "communicate" => {
             if w.windows(2).any(|p| p[0] == "vel" && p[1] == "yes") {
                 Some(Action::Replace(vec!["comm_modify vel yes".into()]))
             } else {
-                Some(Action::Replace(vec![format!("comm_modify {}", w[1..].iter().filter(|x| *x != "single").cloned().collect::<Vec<_>>().join(" "))]))
+                Some(Action::Replace(vec![format!(
+                    "comm_modify {}",
+                    w[1..].iter().filter(|x| *x != "single").cloned().collect::<Vec<_>>().join(" ")
+                )]))
             }
         }
         "pair_style" => {
@@ -310,7 +320,9 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
             lammps::pair_style_to_lammps(ctx, w)
         }
         "pair_coeff" => lammps::pair_coeff_to_lammps(ctx, w),
-        "compute_modify" if w.iter().any(|x| x == "dynamic") => Some(Action::Replace(vec![w.iter().map(|x| if x == "dynamic" { "dynamic/dof" } else { x.as_str() }).collect::<Vec<_>>().join(" ")])),
+        "compute_modify" if w.iter().any(|x| x == "dynamic") => {
+            Some(Action::Replace(vec![w.iter().map(|x| if x == "dynamic" { "dynamic/dof" } else { x.as_str() }).collect::<Vec<_>>().join(" ")]))
+        }
         "dump" if w.get(3).map(|s| s.as_str()) == Some("custom") && w.iter().skip(6).any(|x| refs_dropped(ctx, x)) => {
             let kept: Vec<String> = w.iter().enumerate().filter(|(i, x)| *i < 6 || !refs_dropped(ctx, x)).map(|(_, x)| x.clone()).collect();
             ctx.note(Severity::Approx, "dump columns of dropped or implicit LIGGGHTS fixes removed".into());
@@ -326,13 +338,16 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
                 }
                 Some(Action::Replace(vec![v.join(" ")]))
             }
-            "mesh/stl" | "mesh/vtk" | "local/gran/vtk" | "mesh/vtm" | "stl" | "mesh/gran/VTK" | "custom/vtm" | "atom/vtk" | "euler/vtk" | "decomposition/vtk" => {
+            "mesh/stl" | "mesh/vtk" | "local/gran/vtk" | "mesh/vtm" | "stl" | "mesh/gran/VTK" | "custom/vtm" | "atom/vtk" | "euler/vtk"
+            | "decomposition/vtk" => {
                 ctx.dropped_fixes.insert(w[1].clone());
                 Some(Action::Drop(format!("dump {} has no LAMMPS counterpart", w[3]), Severity::Dropped))
             }
             _ => None,
         },
-        "dump_modify" | "undump" if ctx.dropped_fixes.contains(w.get(1).map(|s| s.as_str()).unwrap_or("")) => Some(Action::Drop("refers to a dropped dump".into(), Severity::Info)),
+        "dump_modify" | "undump" if ctx.dropped_fixes.contains(w.get(1).map(|s| s.as_str()).unwrap_or("")) => {
+            Some(Action::Drop("refers to a dropped dump".into(), Severity::Info))
+        }
         "unfix" if w.len() == 2 && ctx.dropped_fixes.contains(&w[1]) => Some(Action::Drop("refers to a dropped fix".into(), Severity::Info)),
         "thermo_style" if w.iter().any(|x| refs_dropped(ctx, x)) => {
             let kept: Vec<String> = w.iter().filter(|x| !refs_dropped(ctx, x)).cloned().collect();
@@ -351,11 +366,24 @@ fn lammps_rules(ctx: &mut Ctx, w: &[String]) -> Action {
                     }
                 }
                 "wall/gran" => lammps::legacy_wall_to_lammps(ctx, w).or_else(|| lammps::wall_to_lammps(ctx, w)),
-                "insert/pack" | "insert/rate/region" if ctx.facts.gravity.is_none() => Some(Action::Drop("LAMMPS fix pour (the only insertion fix) needs fix gravity".into(), Severity::Dropped)),
+                "insert/pack" | "insert/rate/region" if ctx.facts.gravity.is_none() => {
+                    Some(Action::Drop("LAMMPS fix pour (the only insertion fix) needs fix gravity".into(), Severity::Dropped))
+                }
                 "insert/pack" | "insert/rate/region" => lammps::insert_to_pour(ctx, w),
                 "pour" | "pour/legacy" => lammps::pour_to_lammps(ctx, w),
-                s if s.starts_with("particletemplate/") || s.starts_with("particledistribution/") => Some(Action::Drop("template folded into fix pour".into(), Severity::Info)),
-                s if s.starts_with("mesh/surface") || s.starts_with("move/mesh") || s.starts_with("insert/") || s.starts_with("couple/") || s.starts_with("heat/") || s.starts_with("check/timestep") || s == "property/atom" || s.starts_with("massflow") || s.starts_with("multisphere") => {
+                s if s.starts_with("particletemplate/") || s.starts_with("particledistribution/") => {
+                    Some(Action::Drop("template folded into fix pour".into(), Severity::Info))
+                }
+                s if s.starts_with("mesh/surface")
+                    || s.starts_with("move/mesh")
+                    || s.starts_with("insert/")
+                    || s.starts_with("couple/")
+                    || s.starts_with("heat/")
+                    || s.starts_with("check/timestep")
+                    || s == "property/atom"
+                    || s.starts_with("massflow")
+                    || s.starts_with("multisphere") =>
+                {
                     Some(Action::Drop(format!("fix {s} has no LAMMPS counterpart"), Severity::Dropped))
                 }
                 _ => None,
@@ -386,8 +414,12 @@ fn liggghts_rules(ctx: &mut Ctx, w: &[String], coeffs: &[Vec<String>]) -> Action
         }
         "pair_style" => lammps::classic_to_liggghts(ctx, w).or_else(|| lammps::granular_to_liggghts(ctx, w)),
         "pair_coeff" => lammps::granular_coeff_to_liggghts(ctx, w, coeffs),
-        "compute_modify" if w.iter().any(|x| x == "dynamic/dof") => Some(Action::Replace(vec![w.iter().map(|x| if x == "dynamic/dof" { "dynamic" } else { x.as_str() }).collect::<Vec<_>>().join(" ")])),
-        "dump_modify" if w.iter().any(|x| x == "format") && w.iter().any(|x| x == "float") => Some(Action::Drop("LIGGGHTS accepts only a whole-line dump format".into(), Severity::Approx)),
+        "compute_modify" if w.iter().any(|x| x == "dynamic/dof") => {
+            Some(Action::Replace(vec![w.iter().map(|x| if x == "dynamic/dof" { "dynamic" } else { x.as_str() }).collect::<Vec<_>>().join(" ")]))
+        }
+        "dump_modify" if w.iter().any(|x| x == "format") && w.iter().any(|x| x == "float") => {
+            Some(Action::Drop("LIGGGHTS accepts only a whole-line dump format".into(), Severity::Approx))
+        }
         "fix" if w.len() >= 4 => match w[3].as_str() {
             "wall/gran" => lammps::wall_to_liggghts(ctx, w),
             "pour" => lammps::pour_to_liggghts(ctx, w),

@@ -258,9 +258,7 @@ pub fn group_function_in(sim: &Sim, name: &str, args: &[&str], inside: &dyn Fn(u
             if m == 0.0 {
                 return Ok(0.0);
             }
-            let s: f64 = members()
-                .map(|i| p.mass[i] * if name == "xcm" { unwrapped(sim, i)[k] } else { p.v[i][k] })
-                .sum();
+            let s: f64 = members().map(|i| p.mass[i] * if name == "xcm" { unwrapped(sim, i)[k] } else { p.v[i][k] }).sum();
             s / m
         }
         "bound" => {

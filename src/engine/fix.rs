@@ -90,7 +90,8 @@ impl<'a> Chunk<'a> {
         let n = x.len();
         let (radius, mass, kind, mask) = (&radius[..], &mass[..], &kind[..], &mask[..]);
         // each extra column cut at the chunks
-        let mut cols: Vec<std::slice::ChunksMut<'_, f64>> = extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(size * e.width.max(1))).collect();
+        let mut cols: Vec<std::slice::ChunksMut<'_, f64>> =
+            extra.iter_mut().map(|e| e.data[..n * e.width].chunks_mut(size * e.width.max(1))).collect();
         x.chunks_mut(size)
             .zip(v.chunks_mut(size))
             .zip(omega.chunks_mut(size))
@@ -293,11 +294,7 @@ macro_rules! post_force_only {
             _sim: &$crate::engine::sim::Sim,
             _vars: &$crate::script::Variables,
         ) -> $crate::error::Result<$crate::engine::fix::Local> {
-            Ok(if hook == $crate::engine::fix::Hook::PostForce {
-                $crate::engine::fix::Local::Whole
-            } else {
-                $crate::engine::fix::Local::Nothing
-            })
+            Ok(if hook == $crate::engine::fix::Hook::PostForce { $crate::engine::fix::Local::Whole } else { $crate::engine::fix::Local::Nothing })
         }
         fn end_of_step_due(&self, _step: i64) -> bool {
             false

@@ -61,24 +61,8 @@ fn each_in_group<F>(p: &mut Particles, group: u32, step: F)
 where
     F: Fn(&Half<'_>, usize, &mut V3, &mut V3, &mut V3) + Sync,
 {
-    let Particles {
-        x,
-        v,
-        omega,
-        f,
-        torque,
-        mass,
-        radius,
-        mask,
-        ..
-    } = p;
-    let h = Half {
-        f,
-        torque,
-        mass,
-        radius,
-        mask,
-    };
+    let Particles { x, v, omega, f, torque, mass, radius, mask, .. } = p;
+    let h = Half { f, torque, mass, radius, mask };
     let chunk = |(c, ((xc, vc), wc)): (usize, ((&mut [V3], &mut [V3]), &mut [V3]))| {
         let lo = c * CHUNK;
         for q in 0..xc.len() {
@@ -89,17 +73,9 @@ where
         }
     };
     if x.len() >= 2 * CHUNK {
-        x.par_chunks_mut(CHUNK)
-            .zip(v.par_chunks_mut(CHUNK))
-            .zip(omega.par_chunks_mut(CHUNK))
-            .enumerate()
-            .for_each(chunk);
+        x.par_chunks_mut(CHUNK).zip(v.par_chunks_mut(CHUNK)).zip(omega.par_chunks_mut(CHUNK)).enumerate().for_each(chunk);
     } else {
-        x.chunks_mut(CHUNK)
-            .zip(v.chunks_mut(CHUNK))
-            .zip(omega.chunks_mut(CHUNK))
-            .enumerate()
-            .for_each(chunk);
+        x.chunks_mut(CHUNK).zip(v.chunks_mut(CHUNK)).zip(omega.chunks_mut(CHUNK)).enumerate().for_each(chunk);
     }
 }
 
@@ -297,12 +273,7 @@ mod tests {
         }
         let t = n as f64 * dt;
         let z = 10.0 + 2.0 * t - 0.5 * g * t * t;
-        assert!(
-            (p.x[0].z - z).abs() < 1e-9 * z.abs(),
-            "{} vs {}",
-            p.x[0].z,
-            z
-        );
+        assert!((p.x[0].z - z).abs() < 1e-9 * z.abs(), "{} vs {}", p.x[0].z, z);
         assert!((p.v[0].z - (2.0 - g * t)).abs() < 1e-9);
     }
 
@@ -338,7 +309,20 @@ mod tests {
         // (some in other groups too), which the merged pass runs without a
         // test per particle
         for mixed in [true, false] {
-            merged_halves_bit_for_bit(|| spread(101, |k| if mixed && k % 7 == 0 { 1 } else if k % 3 == 0 { 3 } else { 2 }), mixed);
+            merged_halves_bit_for_bit(
+                || {
+                    spread(101, |k| {
+                        if mixed && k % 7 == 0 {
+                            1
+                        } else if k % 3 == 0 {
+                            3
+                        } else {
+                            2
+                        }
+                    })
+                },
+                mixed,
+            );
         }
     }
 
@@ -377,7 +361,11 @@ mod tests {
             assert_eq!(bits(&a)[0..3] == bits(&c)[0..3], mixed, "particle 0 is outside the group when mixed");
         }
         let fin = FinalHalf { group: 2, dt, rotate: true };
-        for other in [InitialHalf { group: 1, dt, rotate: true }, InitialHalf { group: 2, dt: 2.0 * dt, rotate: true }, InitialHalf { group: 2, dt, rotate: false }] {
+        for other in [
+            InitialHalf { group: 1, dt, rotate: true },
+            InitialHalf { group: 2, dt: 2.0 * dt, rotate: true },
+            InitialHalf { group: 2, dt, rotate: false },
+        ] {
             assert!(fin.then(&other).is_none());
         }
         assert!(InitialHalf { group: 2, dt, rotate: true }.then(&fin).is_none(), "only second half, then first");
@@ -392,10 +380,7 @@ mod tests {
         let make = || spread(n, |k| if k % 5 == 0 { 2 } else { 1 });
         let dt = 1e-5;
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let mut p = make();
             pool.install(|| {
                 initial_integrate(&mut p, 1, dt);

@@ -209,7 +209,16 @@ pub struct PassState<'a> {
 impl<'a> PassState<'a> {
     /// The pass's view of `p`.
     pub fn of(p: &'a Particles) -> PassState<'a> {
-        PassState { x: &p.x, v: &p.v, omega: &p.omega, radius: &p.radius, mass: &p.mass, kind: &p.kind, frozen: &p.frozen, any_frozen: any(&p.frozen) }
+        PassState {
+            x: &p.x,
+            v: &p.v,
+            omega: &p.omega,
+            radius: &p.radius,
+            mass: &p.mass,
+            kind: &p.kind,
+            frozen: &p.frozen,
+            any_frozen: any(&p.frozen),
+        }
     }
 }
 
@@ -550,12 +559,7 @@ impl<T> Shared<T> {
 /// what each adds is added in the same order, so the bits do not depend on
 /// the threads. On one thread this is pass, finish, pass, finish...: a
 /// block's particles are finished while the pass has left them in cache.
-fn fused_blocks<'a>(
-    pairs: &PairList,
-    jobs: Vec<Job<'a>>,
-    pass: &(dyn Fn(&mut Job<'a>) -> Virial + Sync),
-    finish: &Tail<'_>,
-) -> Vec<Virial> {
+fn fused_blocks<'a>(pairs: &PairList, jobs: Vec<Job<'a>>, pass: &(dyn Fn(&mut Job<'a>) -> Virial + Sync), finish: &Tail<'_>) -> Vec<Virial> {
     use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
     use std::sync::{Mutex, PoisonError};
     let nb = jobs.len();
@@ -984,12 +988,40 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
             // SAFETY: q < pe - ps, the block's pairs ([`Block::bounded`])
             unsafe { came_apart(h, lv, q, w, apart) };
             if queued == LANES {
-                self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, LANES, h, d, lv, f, tq, &mut trace, &mut tensor);
+                self.run_batch::<false>(
+                    k,
+                    &mut lanes,
+                    &queue,
+                    &slots,
+                    Dense { first: 0, slot: &mut 0 },
+                    LANES,
+                    h,
+                    d,
+                    lv,
+                    f,
+                    tq,
+                    &mut trace,
+                    &mut tensor,
+                );
                 queued = 0;
             }
         }
         if queued > 0 {
-            self.run_batch::<false>(k, &mut lanes, &queue, &slots, Dense { first: 0, slot: &mut 0 }, queued, h, d, lv, f, tq, &mut trace, &mut tensor);
+            self.run_batch::<false>(
+                k,
+                &mut lanes,
+                &queue,
+                &slots,
+                Dense { first: 0, slot: &mut 0 },
+                queued,
+                h,
+                d,
+                lv,
+                f,
+                tq,
+                &mut trace,
+                &mut tensor,
+            );
         }
         Virial { trace, tensor }
     }
@@ -1354,7 +1386,18 @@ mod tests {
             d.1[b * bs..b * bs + tb.len()].copy_from_slice(tb);
             d.2[b] += 1;
         };
-        let w = laws.force_pass(&PassState::of(p), pl, &mut hist, &mut live, table, 1e-3, Forces { f, torque: t, defer, tensor: false }, fused.then_some(&tail as &Tail<'_>)).trace;
+        let w = laws
+            .force_pass(
+                &PassState::of(p),
+                pl,
+                &mut hist,
+                &mut live,
+                table,
+                1e-3,
+                Forces { f, torque: t, defer, tensor: false },
+                fused.then_some(&tail as &Tail<'_>),
+            )
+            .trace;
         pl.put_history(hist, live);
         if fused {
             let (df, dt, calls) = done.into_inner().unwrap();
@@ -1431,7 +1474,21 @@ mod tests {
         assert!(pe > ps, "block 1 has pairs");
         let (f, h, lv) = (vec![V3::zeros(); 64], vec![0.0; (pe - ps) * w], vec![0u8; pe - ps]);
         let bounded = |state: &PassState<'_>, b: &[u32], image: &[u8], f: &[V3], h: &[f64]| {
-            let k = Block { p: state, a: &pl.a, b, image, images: &pl.images, xs: &[], table: &table, dt: 1e-3, lo: 64, ps, pe, dense: false, tensor: false };
+            let k = Block {
+                p: state,
+                a: &pl.a,
+                b,
+                image,
+                images: &pl.images,
+                xs: &[],
+                table: &table,
+                dt: 1e-3,
+                lo: 64,
+                ps,
+                pe,
+                dense: false,
+                tensor: false,
+            };
             k.bounded(f, f, h, &lv, w)
         };
         let whole = PassState::of(&p);
@@ -1439,7 +1496,16 @@ mod tests {
         // the last particle, a partner of block 1, gone
         let far = pl.b[ps..pe].iter().copied().max().unwrap() as usize;
         let n = far;
-        let fewer = PassState { x: &p.x[..n], v: &p.v[..n], omega: &p.omega[..n], radius: &p.radius[..n], mass: &p.mass[..n], kind: &p.kind[..n], frozen: &p.frozen[..n], any_frozen: false };
+        let fewer = PassState {
+            x: &p.x[..n],
+            v: &p.v[..n],
+            omega: &p.omega[..n],
+            radius: &p.radius[..n],
+            mass: &p.mass[..n],
+            kind: &p.kind[..n],
+            frozen: &p.frozen[..n],
+            any_frozen: false,
+        };
         assert!(!bounded(&fewer, &pl.b, &pl.image, &f, &h));
         let mut b = pl.b.clone();
         b[pe - 1] = p.len() as u32;
@@ -1542,7 +1608,12 @@ mod tests {
     }
 
     /// [`passes`] on the bed `(p, dom)`.
-    fn passes_on<K: ContactKernel>(laws: &K, table: &ParamTable, scalar: bool, (mut p, dom): (Particles, Domain)) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
+    fn passes_on<K: ContactKernel>(
+        laws: &K,
+        table: &ParamTable,
+        scalar: bool,
+        (mut p, dom): (Particles, Domain),
+    ) -> Vec<(Vec<u64>, Vec<u64>, Vec<u64>, u64)> {
         let mut pl = PairList { block: 128, ..Default::default() };
         let settings = NeighSettings { skin: 0.05, ..Default::default() };
         let mut out = vec![];
@@ -1590,7 +1661,9 @@ mod tests {
 
     /// LAMMPS gran/hooke/history on [`two_type_table`]: one type pair
     /// without tangential damping and with little friction.
-    fn gran_hooke() -> (Laws<crate::physics::normal::gran::LammpsGranHooke, crate::physics::tangential::gran::LammpsGranHistory, NoCohesion, NoRolling>, ParamTable) {
+    fn gran_hooke(
+    ) -> (Laws<crate::physics::normal::gran::LammpsGranHooke, crate::physics::tangential::gran::LammpsGranHistory, NoCohesion, NoRolling>, ParamTable)
+    {
         use crate::physics::normal::gran::LammpsGranHooke;
         use crate::physics::tangential::gran::LammpsGranHistory;
         let laws = Laws { normal: LammpsGranHooke, tangential: LammpsGranHistory, cohesion: NoCohesion, rolling: NoRolling };
@@ -1623,8 +1696,11 @@ mod tests {
         let mut light = bed.clone();
         light.0.frozen.iter_mut().for_each(|f| *f = false);
         for scalar in [false, true] {
-            let (frozen, heavy, light) =
-                (passes_on(&laws, &table, scalar, bed.clone()), passes_on(&laws, &table, scalar, heavy.clone()), passes_on(&laws, &table, scalar, light.clone()));
+            let (frozen, heavy, light) = (
+                passes_on(&laws, &table, scalar, bed.clone()),
+                passes_on(&laws, &table, scalar, heavy.clone()),
+                passes_on(&laws, &table, scalar, light.clone()),
+            );
             assert_eq!(frozen, heavy, "scalar pass: {scalar}");
             assert_ne!(frozen, light, "scalar pass: {scalar}: the frozen flags changed nothing");
         }
@@ -1636,7 +1712,13 @@ mod tests {
         // frozen, then mi if j is
         let (mi, mj) = (2.5, 0.75);
         for (fi, fj) in [(false, false), (true, false), (false, true), (true, true)] {
-            let lammps = if fj { mi } else if fi { mj } else { mi * mj / (mi + mj) };
+            let lammps = if fj {
+                mi
+            } else if fi {
+                mj
+            } else {
+                mi * mj / (mi + mj)
+            };
             let (a, b) = frozen_masses(fi, fj, mi, mj);
             assert_eq!(effective_mass(a, b), lammps, "i frozen {fi}, j frozen {fj}");
         }

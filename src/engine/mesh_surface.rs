@@ -352,13 +352,31 @@ impl SurfaceMesh {
         let cell = if n == 0 {
             1.0
         } else {
-            tris.iter().map(|t| {
-                let (a, b) = t.bounds();
-                (b - a).max()
-            }).sum::<f64>() / n as f64
+            tris.iter()
+                .map(|t| {
+                    let (a, b) = t.bounds();
+                    (b - a).max()
+                })
+                .sum::<f64>()
+                / n as f64
         };
         let bins = TriangleBins::new(&mesh, cell);
-        SurfaceMesh { id: id.to_string(), wall_type, tris, bins, edge_active, corner_active, coplanar, nneighs, curvature_cos, motion: None, surface_vel: None, moving: false, epoch: 0, stress: None }
+        SurfaceMesh {
+            id: id.to_string(),
+            wall_type,
+            tris,
+            bins,
+            edge_active,
+            corner_active,
+            coplanar,
+            nneighs,
+            curvature_cos,
+            motion: None,
+            surface_vel: None,
+            moving: false,
+            epoch: 0,
+            stress: None,
+        }
     }
 
     /// Whether all triangles lie in one plane within the curvature
@@ -382,7 +400,13 @@ impl SurfaceMesh {
             Some((MeshMotion::Rotate { origin, axis, period }, t0)) => {
                 // the angle of `MeshMotion::position`; back is its exact negative
                 let angle = 2.0 * std::f64::consts::PI * (time - t0) / period;
-                PoseMotion::Rotate { origin, axis, fwd: angle.sin_cos(), back: (-angle).sin_cos(), omega: axis * (2.0 * std::f64::consts::PI / period) }
+                PoseMotion::Rotate {
+                    origin,
+                    axis,
+                    fwd: angle.sin_cos(),
+                    back: (-angle).sin_cos(),
+                    omega: axis * (2.0 * std::f64::consts::PI / period),
+                }
             }
         };
         Pose { motion, moving: self.moving, surface_vel: self.surface_vel }
@@ -490,10 +514,12 @@ impl SurfaceMesh {
     pub fn current_triangles(&self, time: f64) -> Vec<[[f64; 3]; 3]> {
         self.tris
             .iter()
-            .map(|t| t.v.map(|p| {
-                let w = self.to_world(p, time);
-                [w.x, w.y, w.z]
-            }))
+            .map(|t| {
+                t.v.map(|p| {
+                    let w = self.to_world(p, time);
+                    [w.x, w.y, w.z]
+                })
+            })
             .collect()
     }
 
@@ -502,10 +528,14 @@ impl SurfaceMesh {
         if self.motion.is_none() {
             return;
         }
-        let tris: Vec<Triangle> = self.tris.iter().map(|t| {
-            let v = t.v.map(|p| self.to_world(p, time));
-            Triangle::new(v[0], v[1], v[2])
-        }).collect();
+        let tris: Vec<Triangle> = self
+            .tris
+            .iter()
+            .map(|t| {
+                let v = t.v.map(|p| self.to_world(p, time));
+                Triangle::new(v[0], v[1], v[2])
+            })
+            .collect();
         self.tris = tris;
         let cell = self.bins_cell();
         self.bins = TriangleBins::new(&Mesh::new(self.tris.clone()), cell);
@@ -516,17 +546,24 @@ impl SurfaceMesh {
 
     fn bins_cell(&self) -> f64 {
         let n = self.tris.len().max(1) as f64;
-        self.tris.iter().map(|t| {
-            let (a, b) = t.bounds();
-            (b - a).max()
-        }).sum::<f64>() / n
+        self.tris
+            .iter()
+            .map(|t| {
+                let (a, b) = t.bounds();
+                (b - a).max()
+            })
+            .sum::<f64>()
+            / n
     }
 
     /// The triangles (increasing) closer than `reach` to point `p`
     /// (reference frame): every triangle that a sphere centred within
     /// `reach - r` of `p` can touch with radius `r`.
     pub fn near(&self, p: V3, reach: f64) -> impl Iterator<Item = usize> + '_ {
-        self.bins.candidates(p, reach).into_iter().filter(move |&t| (p - closest_point_on_triangle(p, &self.tris[t]).0).norm_squared() < reach * reach)
+        self.bins
+            .candidates(p, reach)
+            .into_iter()
+            .filter(move |&t| (p - closest_point_on_triangle(p, &self.tris[t]).0).norm_squared() < reach * reach)
     }
 
     /// Contact of a sphere (reference frame) with triangle `t` under the
@@ -703,10 +740,7 @@ pub fn resolve_among(
                     continue;
                 }
                 let Some(k) = (0..MESH_SLOTS).find(|&k| slot_id(k) == 0.0) else {
-                    return Err(Error::runtime(format!(
-                        "mesh wall '{}': a particle touches more than {MESH_SLOTS} triangles at once",
-                        mesh.id
-                    )));
+                    return Err(Error::runtime(format!("mesh wall '{}': a particle touches more than {MESH_SLOTS} triangles at once", mesh.id)));
                 };
                 data[k * w] = idv;
                 data[k * w + 1..(k + 1) * w].fill(0.0);

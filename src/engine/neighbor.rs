@@ -1891,7 +1891,8 @@ mod tests {
         let (dom, mut p) = gas_of(&mut lcg(21), n);
         let s = NeighSettings { skin: 0.1, ..Default::default() };
         let mut pl = PairList::default();
-        let ids = |pl: &PairList, p: &Particles| -> Vec<(i64, i64)> { (0..pl.len()).map(|k| (p.tag[pl.a[k] as usize], p.tag[pl.b[k] as usize])).collect() };
+        let ids =
+            |pl: &PairList, p: &Particles| -> Vec<(i64, i64)> { (0..pl.len()).map(|k| (p.tag[pl.a[k] as usize], p.tag[pl.b[k] as usize])).collect() };
         let check = |pl: &PairList, p: &Particles, with_history: bool| {
             assert!(pl.len() > n as usize, "more pairs than particles: {}", pl.len());
             // pairs by first particle, each after its chunk's predecessors

@@ -214,16 +214,7 @@ mod tests {
     use super::*;
 
     fn np(tag: i64) -> NewParticle {
-        NewParticle {
-            tag,
-            kind: 1,
-            mask: 1,
-            x: V3::new(tag as f64, 0.0, 0.0),
-            v: V3::zeros(),
-            omega: V3::zeros(),
-            radius: 0.5,
-            density: 1000.0,
-        }
+        NewParticle { tag, kind: 1, mask: 1, x: V3::new(tag as f64, 0.0, 0.0), v: V3::zeros(), omega: V3::zeros(), radius: 0.5, density: 1000.0 }
     }
 
     #[test]

@@ -399,10 +399,7 @@ impl WindFix {
     fn write_record(&mut self, sim: &Sim) {
         let Some(f) = self.file.as_mut() else { return };
         let nb = self.edges.len() - 1;
-        let mut s = format!(
-            "# step {} time {:.9e} zb {:.9e} ustar {:.9e} nbins {}\n",
-            sim.step, sim.time, self.zb, self.params.ustar, nb
-        );
+        let mut s = format!("# step {} time {:.9e} zb {:.9e} ustar {:.9e} nbins {}\n", sim.step, sim.time, self.zb, self.params.ustar, nb);
         for k in 0..nb {
             let zc = 0.5 * (self.edges[k] + self.edges[k + 1]);
             let u = if self.cfg.feedback { self.profile.at(zc, &self.params) } else { self.params.log_law(zc - self.zb) };
@@ -591,7 +588,15 @@ impl Fix for WindFix {
         let c = &self.cfg;
         format!(
             "aeolian/wind (fix {}): u* {:?}, z0 {:e}, rho_f {}, nu_f {:e}, drag {:?}, bed {:?}, feedback {}, every {}",
-            c.id, c.ustar, c.z0, c.rho_f, c.nu_f, c.drag, c.bed, if c.feedback { "yes" } else { "no" }, c.every
+            c.id,
+            c.ustar,
+            c.z0,
+            c.rho_f,
+            c.nu_f,
+            c.drag,
+            c.bed,
+            if c.feedback { "yes" } else { "no" },
+            c.every
         )
     }
 }
@@ -609,10 +614,7 @@ mod tests {
         while re < 1e5 {
             let want = ((32.0 / re).powf(2.0 / 3.0) + 1.0).powf(1.5);
             let got = DragLaw::Cheng.cd(re);
-            assert!(
-                (got - want).abs() <= 1e-13 * want,
-                "Re {re}: {got} vs {want}"
-            );
+            assert!((got - want).abs() <= 1e-13 * want, "Re {re}: {got} vs {want}");
             re *= 1.37;
         }
         // the limits of the law: 32/Re in creeping flow, 1 at high Re

@@ -289,21 +289,13 @@ impl Lattice {
         y1 *= self.scale;
         z1 *= self.scale;
         let r = &self.rotaterow;
-        V3::new(
-            r[0][0] * x1 + r[0][1] * y1 + r[0][2] * z1,
-            r[1][0] * x1 + r[1][1] * y1 + r[1][2] * z1,
-            r[2][0] * x1 + r[2][1] * y1 + r[2][2] * z1,
-        )
+        V3::new(r[0][0] * x1 + r[0][1] * y1 + r[0][2] * z1, r[1][0] * x1 + r[1][1] * y1 + r[1][2] * z1, r[2][0] * x1 + r[2][1] * y1 + r[2][2] * z1)
     }
 
     /// Lattice coordinates -> box coordinates (LAMMPS `lattice2box`).
     pub fn lattice_to_box(&self, x: [f64; 3]) -> V3 {
         let v = self.cell_to_box_no_origin(x);
-        V3::new(
-            v.x + self.spacing.x * self.origin[0],
-            v.y + self.spacing.y * self.origin[1],
-            v.z + self.spacing.z * self.origin[2],
-        )
+        V3::new(v.x + self.spacing.x * self.origin[0], v.y + self.spacing.y * self.origin[1], v.z + self.spacing.z * self.origin[2])
     }
 
     /// Box coordinates -> lattice coordinates (inverse transform, used for loop bounds).
@@ -320,13 +312,7 @@ impl Lattice {
     /// order, with the basis index (0-based) of each point. `periodic` gives
     /// the periodicity of x, y, z. Errors for `lattice none` and when more
     /// than 1e8 lattice sites would be visited.
-    pub fn create_points(
-        &self,
-        box_lo: V3,
-        box_hi: V3,
-        periodic: [bool; 3],
-        filter: Option<&dyn Fn(V3) -> bool>,
-    ) -> Result<Vec<(V3, usize)>> {
+    pub fn create_points(&self, box_lo: V3, box_hi: V3, periodic: [bool; 3], filter: Option<&dyn Fn(V3) -> bool>) -> Result<Vec<(V3, usize)>> {
         if self.style == LatticeStyle::None || self.basis.is_empty() {
             return Err(Error::runtime("cannot create atoms with undefined lattice"));
         }

@@ -236,9 +236,7 @@ impl Mesh {
     }
     /// The mesh after rigid motion `m` at time `t` (from this reference position).
     pub fn moved(&self, m: &MeshMotion, t: f64) -> Mesh {
-        Mesh {
-            tris: self.tris.iter().map(|tr| Triangle::new(m.position(tr.v[0], t), m.position(tr.v[1], t), m.position(tr.v[2], t))).collect(),
-        }
+        Mesh { tris: self.tris.iter().map(|tr| Triangle::new(m.position(tr.v[0], t), m.position(tr.v[1], t), m.position(tr.v[2], t))).collect() }
     }
 }
 
@@ -297,9 +295,7 @@ impl MeshMotion {
     pub fn position(&self, p0: V3, t: f64) -> V3 {
         match *self {
             MeshMotion::Linear(v) => p0 + v * t,
-            MeshMotion::Rotate { origin, axis, period } => {
-                origin + rotate_about(p0 - origin, axis, 2.0 * std::f64::consts::PI * t / period)
-            }
+            MeshMotion::Rotate { origin, axis, period } => origin + rotate_about(p0 - origin, axis, 2.0 * std::f64::consts::PI * t / period),
         }
     }
     /// Wall velocity at the current point `p` (any t for these motions).

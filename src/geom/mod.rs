@@ -10,11 +10,11 @@
 //! Everything here is pure geometry; forces belong to `physics`, stepping
 //! and neighbour bookkeeping to `engine`.
 
-pub mod region;
 pub mod lattice;
-pub mod stl;
 pub mod mesh;
 pub mod primitive;
+pub mod region;
+pub mod stl;
 
 pub use lattice::{parse_lattice, Lattice, LatticeStyle};
 pub use mesh::{sphere_triangle_contact, ContactKind, Mesh, MeshMotion, MeshTransform, Triangle, TriangleBins};
@@ -30,9 +30,8 @@ use crate::script::{Command, Span, Word};
 /// (digits, sign, `.`, exponent; no `inf`/`nan`).
 pub(crate) fn parse_f64(w: &Word, what: &str) -> Result<f64> {
     let t = w.text.trim();
-    let ok_chars = !t.is_empty()
-        && t.chars().all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-'))
-        && t.chars().any(|c| c.is_ascii_digit());
+    let ok_chars =
+        !t.is_empty() && t.chars().all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-')) && t.chars().any(|c| c.is_ascii_digit());
     match t.parse::<f64>() {
         Ok(v) if ok_chars && v.is_finite() => Ok(v),
         _ => Err(Error::deck(w.span, format!("expected a number for {what}, found '{}'", w.text))),
@@ -41,10 +40,7 @@ pub(crate) fn parse_f64(w: &Word, what: &str) -> Result<f64> {
 
 /// Parse an integer (LAMMPS `utils::inumeric`).
 pub(crate) fn parse_i64(w: &Word, what: &str) -> Result<i64> {
-    w.text
-        .trim()
-        .parse::<i64>()
-        .map_err(|_| Error::deck(w.span, format!("expected an integer for {what}, found '{}'", w.text)))
+    w.text.trim().parse::<i64>().map_err(|_| Error::deck(w.span, format!("expected an integer for {what}, found '{}'", w.text)))
 }
 
 /// The word at `i` of `args`, or an error at the end of the command saying what is missing.

@@ -232,8 +232,7 @@ pub fn parse_region(cmd: &Command, ctx: &RegionParseCtx) -> Result<Region> {
             }
             "rotate" => {
                 let v = need(cmd, kw, i + 1, "rotate v_theta Px Py Pz Rx Ry Rz")?;
-                let name = var_name(v)?
-                    .ok_or_else(|| Error::deck(v.span, "rotate needs an equal-style variable v_name"))?;
+                let name = var_name(v)?.ok_or_else(|| Error::deck(v.span, "rotate needs an equal-style variable v_name"))?;
                 let p = super::need_v3(cmd, kw, i + 2, "rotation point")?;
                 let ax = super::need_v3(cmd, kw, i + 5, "rotation axis")?;
                 if ax.norm() == 0.0 {
@@ -261,9 +260,7 @@ pub fn parse_region(cmd: &Command, ctx: &RegionParseCtx) -> Result<Region> {
     let bound = |w: &Word, dim: usize, is_lo: bool, s: f64| -> Result<f64> {
         match w.text.as_str() {
             "INF" | "EDGE" => {
-                let (blo, bhi) = ctx.box_bounds.ok_or_else(|| {
-                    Error::deck(w.span, "cannot use region INF or EDGE when the box does not exist")
-                })?;
+                let (blo, bhi) = ctx.box_bounds.ok_or_else(|| Error::deck(w.span, "cannot use region INF or EDGE when the box does not exist"))?;
                 let _ = (blo, bhi);
                 Ok(match (w.text.as_str(), is_lo) {
                     ("INF", true) => -BIG,
@@ -363,21 +360,8 @@ pub fn parse_region(cmd: &Command, ctx: &RegionParseCtx) -> Result<Region> {
         }
     };
     let _ = any_open;
-    let motion = if move_vars.is_some() || rotate.is_some() {
-        Some(RegionMotion { move_vars, rotate, scale })
-    } else {
-        None
-    };
-    Ok(Region {
-        id: idw.text.clone(),
-        shape,
-        interior,
-        open,
-        motion,
-        disp: V3::zeros(),
-        angle: 0.0,
-        box_bounds: ctx.box_bounds,
-    })
+    let motion = if move_vars.is_some() || rotate.is_some() { Some(RegionMotion { move_vars, rotate, scale }) } else { None };
+    Ok(Region { id: idw.text.clone(), shape, interior, open, motion, disp: V3::zeros(), angle: 0.0, box_bounds: ctx.box_bounds })
 }
 
 fn var_name(w: &Word) -> Result<Option<String>> {
@@ -748,7 +732,11 @@ impl Region {
     fn surface_distance_local(&self, q: V3) -> f64 {
         // every face closed; q is in the own frame already
         const CLOSED: [bool; 6] = [false; 6];
-        let c = if self.inside(q) { self.interior_contacts(q, f64::INFINITY, CLOSED) } else { self.exterior_contacts(q, f64::INFINITY, CLOSED).into_iter().collect() };
+        let c = if self.inside(q) {
+            self.interior_contacts(q, f64::INFINITY, CLOSED)
+        } else {
+            self.exterior_contacts(q, f64::INFINITY, CLOSED).into_iter().collect()
+        };
         if c.is_empty() {
             return 0.0;
         }
@@ -947,9 +935,24 @@ impl Region {
             }
             u.map(|u| base + u * pr)
         };
-        let cap_lo = if *rlo > 0.0 && *lo > -BIG { let (x, y) = seg(*lo, 0.0, *lo, *rlo); to3(x, y) } else { None };
-        let cap_hi = if *rhi > 0.0 && *hi < BIG { let (x, y) = seg(*hi, 0.0, *hi, *rhi); to3(x, y) } else { None };
-        let lat = if u.is_some() { let (x, y) = seg(*lo, *rlo, *hi, *rhi); to3(x, y) } else { None };
+        let cap_lo = if *rlo > 0.0 && *lo > -BIG {
+            let (x, y) = seg(*lo, 0.0, *lo, *rlo);
+            to3(x, y)
+        } else {
+            None
+        };
+        let cap_hi = if *rhi > 0.0 && *hi < BIG {
+            let (x, y) = seg(*hi, 0.0, *hi, *rhi);
+            to3(x, y)
+        } else {
+            None
+        };
+        let lat = if u.is_some() {
+            let (x, y) = seg(*lo, *rlo, *hi, *rhi);
+            to3(x, y)
+        } else {
+            None
+        };
         let _ = v3_axis;
         [cap_lo, cap_hi, lat]
     }

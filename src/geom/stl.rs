@@ -46,7 +46,11 @@ pub fn read_stl_bytes(bytes: &[u8], name: &str, span: Span) -> Result<Vec<Triang
             span,
             name,
             None,
-            format!("not ASCII STL (no 'solid') and not binary STL ({} bytes, header says {n} triangles = {} bytes)", bytes.len(), 84u128 + 50 * n as u128),
+            format!(
+                "not ASCII STL (no 'solid') and not binary STL ({} bytes, header says {n} triangles = {} bytes)",
+                bytes.len(),
+                84u128 + 50 * n as u128
+            ),
         ));
     }
     Err(file_err(span, name, None, "file too short to be STL"))
@@ -97,11 +101,7 @@ fn read_ascii(bytes: &[u8], name: &str, span: Span) -> Result<Vec<Triangle>> {
                 let mut c = [0.0; 3];
                 for ck in c.iter_mut() {
                     let t = toks.next().ok_or_else(|| err("vertex needs three coordinates".into()))?;
-                    *ck = t
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|v| v.is_finite())
-                        .ok_or_else(|| err(format!("bad vertex coordinate '{t}'")))?;
+                    *ck = t.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| err(format!("bad vertex coordinate '{t}'")))?;
                 }
                 if verts.len() == 3 {
                     return Err(err("more than three vertices in a facet".into()));

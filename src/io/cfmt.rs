@@ -84,17 +84,7 @@ impl CFormat {
                 i += 1;
                 continue;
             }
-            let mut s = Spec {
-                left: false,
-                plus: false,
-                space: false,
-                zero: false,
-                alt: false,
-                width: 0,
-                precision: None,
-                long: 0,
-                conv: 0,
-            };
+            let mut s = Spec { left: false, plus: false, space: false, zero: false, alt: false, width: 0, precision: None, long: 0, conv: 0 };
             while i < b.len() {
                 match b[i] {
                     b'-' => s.left = true,
@@ -143,8 +133,7 @@ impl CFormat {
                 return Err(format!("incomplete conversion '{}' at the end of format '{fmt}'", &fmt[pct..]));
             }
             match b[i] {
-                b'd' | b'i' | b'u' | b'x' | b'X' | b'o' | b'c' | b'e' | b'E' | b'f' | b'F' | b'g' | b'G'
-                | b's' => s.conv = b[i],
+                b'd' | b'i' | b'u' | b'x' | b'X' | b'o' | b'c' | b'e' | b'E' | b'f' | b'F' | b'g' | b'G' | b's' => s.conv = b[i],
                 _ => {
                     let end = fmt[i..].chars().next().map_or(i + 1, |c| i + c.len_utf8());
                     return Err(format!("unknown conversion '{}' in format '{fmt}'", &fmt[pct..end]));
@@ -187,9 +176,7 @@ impl CFormat {
             match p {
                 Piece::Lit(s) => out.push_str(s),
                 Piece::Conv(s) => {
-                    let a = args
-                        .get(next)
-                        .ok_or_else(|| format!("format needs more than {} argument(s)", args.len()))?;
+                    let a = args.get(next).ok_or_else(|| format!("format needs more than {} argument(s)", args.len()))?;
                     next += 1;
                     write_conv(out, s, a)?;
                 }
@@ -214,17 +201,7 @@ pub fn sprintf(fmt: &str, args: &[CArg]) -> Result<String, String> {
 /// C `%.{precision}g` of one number.
 pub fn fmt_g(x: f64, precision: usize) -> String {
     let mut out = String::new();
-    let s = Spec {
-        left: false,
-        plus: false,
-        space: false,
-        zero: false,
-        alt: false,
-        width: 0,
-        precision: Some(precision),
-        long: 0,
-        conv: b'g',
-    };
+    let s = Spec { left: false, plus: false, space: false, zero: false, alt: false, width: 0, precision: Some(precision), long: 0, conv: b'g' };
     write_float(&mut out, &s, x);
     out
 }
@@ -237,17 +214,7 @@ pub fn fmt_g6(x: f64) -> String {
 /// C `%-1.16e` (the box-bound format of LAMMPS dumps and LIGGGHTS data files).
 pub fn fmt_e16(x: f64) -> String {
     let mut out = String::new();
-    let s = Spec {
-        left: true,
-        plus: false,
-        space: false,
-        zero: false,
-        alt: false,
-        width: 1,
-        precision: Some(16),
-        long: 0,
-        conv: b'e',
-    };
+    let s = Spec { left: true, plus: false, space: false, zero: false, alt: false, width: 1, precision: Some(16), long: 0, conv: b'e' };
     write_float(&mut out, &s, x);
     out
 }
@@ -541,7 +508,10 @@ mod tests {
         assert_eq!(f("%+.2e", 12345.678), "+1.23e+04");
         assert_eq!(f("%5.1f", f64::INFINITY), "  inf");
         assert_eq!(f("%05G", f64::NAN), "  NAN");
-        assert_eq!(sprintf("%5d|%-5d|%05d|%+d|% d", &[CArg::Int(42), CArg::Int(-42), CArg::Int(-42), CArg::Int(7), CArg::Int(7)]).unwrap(), "   42|-42  |-0042|+7| 7");
+        assert_eq!(
+            sprintf("%5d|%-5d|%05d|%+d|% d", &[CArg::Int(42), CArg::Int(-42), CArg::Int(-42), CArg::Int(7), CArg::Int(7)]).unwrap(),
+            "   42|-42  |-0042|+7| 7"
+        );
         assert_eq!(sprintf("%.0d|%.3d|%u", &[CArg::Int(0), CArg::Int(5), CArg::Int(-1)]).unwrap(), "|005|4294967295");
         assert_eq!(sprintf("%s=%5s%%", &[CArg::Str("a"), CArg::Str("bc")]).unwrap(), "a=   bc%");
     }

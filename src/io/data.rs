@@ -90,9 +90,7 @@ pub fn parse_data(text: &str, name: &str) -> Result<DataFile> {
         let count = |s: &str| s.parse::<usize>().map_err(|_| err(i + 1, format!("'{s}' is not a count")));
         match w.as_slice() {
             [n, "atoms"] => natoms = Some(count(n)?),
-            [n, "atom", "types"] => {
-                df.atom_types = u32::try_from(count(n)?).map_err(|_| err(i + 1, "too many atom types".into()))?
-            }
+            [n, "atom", "types"] => df.atom_types = u32::try_from(count(n)?).map_err(|_| err(i + 1, "too many atom types".into()))?,
             [a, b, "xlo", "xhi"] => (df.lo[0], df.hi[0]) = (num(a)?, num(b)?),
             [a, b, "ylo", "yhi"] => (df.lo[1], df.hi[1]) = (num(a)?, num(b)?),
             [a, b, "zlo", "zhi"] => (df.lo[2], df.hi[2]) = (num(a)?, num(b)?),
@@ -152,17 +150,15 @@ pub fn parse_data(text: &str, name: &str) -> Result<DataFile> {
                 continue;
             }
             let w: Vec<&str> = l.split_whitespace().collect();
-            let f = |k: usize| -> Result<f64> {
-                w[k].parse::<f64>().map_err(|_| err(i, format!("'{}' is not a number", w[k])))
-            };
+            let f = |k: usize| -> Result<f64> { w[k].parse::<f64>().map_err(|_| err(i, format!("'{}' is not a number", w[k]))) };
             let int = |k: usize| -> Result<i64> { w[k].parse::<i64>().map_err(|_| err(i, format!("'{}' is not an integer", w[k]))) };
             match title {
                 "Atoms" => {
                     if w.len() != 7 && w.len() != 10 {
-                        return Err(err(i, format!(
-                            "an atom_style sphere line has 7 or 10 values (id type diameter density x y z [ix iy iz]), found {}",
-                            w.len()
-                        )));
+                        return Err(err(
+                            i,
+                            format!("an atom_style sphere line has 7 or 10 values (id type diameter density x y z [ix iy iz]), found {}", w.len()),
+                        ));
                     }
                     let id = u64::try_from(int(0)?).map_err(|_| err(i, format!("bad atom id '{}'", w[0])))?;
                     let kind = u32::try_from(int(1)?).map_err(|_| err(i, format!("bad atom type '{}'", w[1])))?;
@@ -237,12 +233,10 @@ pub fn format_data(df: &DataFile, engine: Engine, timestep: u64) -> String {
     };
     let mut o = String::new();
     match engine {
-        Engine::Lammps => {
-            o.push_str(&format!("LAMMPS data file via write_data, version 29 Sep 2021, timestep = {timestep}\n"))
+        Engine::Lammps => o.push_str(&format!("LAMMPS data file via write_data, version 29 Sep 2021, timestep = {timestep}\n")),
+        Engine::Liggghts => {
+            o.push_str(&format!("LAMMPS data file via write_data, version Version LIGGGHTS-PUBLIC 3.8.0 (written by demx), timestep = {timestep}\n"))
         }
-        Engine::Liggghts => o.push_str(&format!(
-            "LAMMPS data file via write_data, version Version LIGGGHTS-PUBLIC 3.8.0 (written by demx), timestep = {timestep}\n"
-        )),
     }
     o.push_str(&format!("\n{} atoms\n{} atom types\n\n", df.atoms.len(), df.atom_types));
     for (k, n) in ["x", "y", "z"].iter().enumerate() {
@@ -289,8 +283,7 @@ pub fn format_data(df: &DataFile, engine: Engine, timestep: u64) -> String {
 /// Write `df` as `engine`'s `write_data` would.
 pub fn write_data(path: impl AsRef<Path>, df: &DataFile, engine: Engine, timestep: u64) -> Result<()> {
     let path = path.as_ref();
-    std::fs::write(path, format_data(df, engine, timestep))
-        .map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", path.display()), &e))
+    std::fs::write(path, format_data(df, engine, timestep)).map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", path.display()), &e))
 }
 
 #[cfg(test)]

@@ -77,12 +77,7 @@ impl BoxBounds {
     /// Inverse of [`BoxBounds::file_bounds`].
     fn from_file_bounds(v: [[f64; 3]; 3], tilt: bool, boundary: [String; 3]) -> BoxBounds {
         if !tilt {
-            return BoxBounds {
-                lo: [v[0][0], v[1][0], v[2][0]],
-                hi: [v[0][1], v[1][1], v[2][1]],
-                tilt: None,
-                boundary,
-            };
+            return BoxBounds { lo: [v[0][0], v[1][0], v[2][0]], hi: [v[0][1], v[1][1], v[2][1]], tilt: None, boundary };
         }
         let (xy, xz, yz) = (v[0][2], v[1][2], v[2][2]);
         let xmin = 0f64.min(xy).min(xz).min(xy + xz);
@@ -117,11 +112,7 @@ impl BoxBounds {
     pub fn from_scaled(&self, s: [f64; 3]) -> [f64; 3] {
         let prd = [self.hi[0] - self.lo[0], self.hi[1] - self.lo[1], self.hi[2] - self.lo[2]];
         let [xy, xz, yz] = self.tilt.unwrap_or([0.0; 3]);
-        [
-            prd[0] * s[0] + xy * s[1] + xz * s[2] + self.lo[0],
-            prd[1] * s[1] + yz * s[2] + self.lo[1],
-            prd[2] * s[2] + self.lo[2],
-        ]
+        [prd[0] * s[0] + xy * s[1] + xz * s[2] + self.lo[0], prd[1] * s[1] + yz * s[2] + self.lo[1], prd[2] * s[2] + self.lo[2]]
     }
 }
 
@@ -204,15 +195,10 @@ impl DumpReader {
         let path = path.as_ref();
         let f = File::open(path).map_err(|e| Error::io(Span::DUMMY, format!("cannot read '{}'", path.display()), &e))?;
         let mut br = BufReader::with_capacity(1 << 16, f);
-        let head = br
-            .fill_buf()
-            .map_err(|e| Error::io(Span::DUMMY, format!("cannot read '{}'", path.display()), &e))?;
+        let head = br.fill_buf().map_err(|e| Error::io(Span::DUMMY, format!("cannot read '{}'", path.display()), &e))?;
         let gzip = head.len() >= 2 && head[0] == 0x1f && head[1] == 0x8b;
-        let input: Box<dyn BufRead> = if gzip {
-            Box::new(BufReader::with_capacity(1 << 16, flate2::bufread::MultiGzDecoder::new(br)))
-        } else {
-            Box::new(br)
-        };
+        let input: Box<dyn BufRead> =
+            if gzip { Box::new(BufReader::with_capacity(1 << 16, flate2::bufread::MultiGzDecoder::new(br))) } else { Box::new(br) };
         Ok(DumpReader::from_reader(input, &path.display().to_string(), gzip))
     }
 
@@ -253,15 +239,9 @@ impl DumpReader {
             Ok(n) => n,
             Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => 0,
             Err(e) if e.kind() == std::io::ErrorKind::InvalidData && !self.gzip => {
-                return Err(ReadErr::Bad(Error::usage(format!(
-                    "{}:{}: not a text dump (invalid UTF-8)",
-                    self.path,
-                    self.line_no + 1
-                ))))
+                return Err(ReadErr::Bad(Error::usage(format!("{}:{}: not a text dump (invalid UTF-8)", self.path, self.line_no + 1))))
             }
-            Err(e) => {
-                return Err(ReadErr::Bad(Error::usage(format!("{}:{}: read error: {e}", self.path, self.line_no + 1))))
-            }
+            Err(e) => return Err(ReadErr::Bad(Error::usage(format!("{}:{}: read error: {e}", self.path, self.line_no + 1)))),
         };
         if n == 0 {
             return Ok(None);
@@ -346,11 +326,7 @@ impl DumpReader {
                 self.need(ts, "the units value")?;
             } else if rest == "NUMBER OF ATOMS" {
                 let l = self.need(ts, "the number of atoms")?;
-                natoms = Some(
-                    l.trim()
-                        .parse::<usize>()
-                        .map_err(|_| self.bad(format!("bad number of atoms '{}'", short(&l))))?,
-                );
+                natoms = Some(l.trim().parse::<usize>().map_err(|_| self.bad(format!("bad number of atoms '{}'", short(&l))))?);
             } else if let Some(flags) = rest.strip_prefix("BOX BOUNDS") {
                 let words: Vec<&str> = flags.split_whitespace().collect();
                 let tilt = words.len() >= 3 && words[..3] == ["xy", "xz", "yz"];
@@ -548,21 +524,11 @@ impl DumpInfo {
             if lo == hi {
                 o.push_str(&format!("atoms: {lo} per frame\n"));
             } else {
-                o.push_str(&format!(
-                    "atoms: {} .. {} (first frame {}, last frame {})\n",
-                    lo,
-                    hi,
-                    self.atoms[0],
-                    self.atoms[self.atoms.len() - 1]
-                ));
+                o.push_str(&format!("atoms: {} .. {} (first frame {}, last frame {})\n", lo, hi, self.atoms[0], self.atoms[self.atoms.len() - 1]));
             }
         }
         if !self.columns.is_empty() {
-            o.push_str(&format!(
-                "columns: {}{}\n",
-                self.columns.join(" "),
-                if self.columns_change { " (changes in later frames)" } else { "" }
-            ));
+            o.push_str(&format!("columns: {}{}\n", self.columns.join(" "), if self.columns_change { " (changes in later frames)" } else { "" }));
         }
         if let Some(b) = &self.first_box {
             o.push_str(&format!(
@@ -713,8 +679,7 @@ impl DumpOptions {
         match self.style {
             DumpStyle::Custom => self.columns.clone(),
             DumpStyle::Atom => {
-                let mut c: Vec<&str> =
-                    if self.scale { vec!["id", "type", "xs", "ys", "zs"] } else { vec!["id", "type", "x", "y", "z"] };
+                let mut c: Vec<&str> = if self.scale { vec!["id", "type", "xs", "ys", "zs"] } else { vec!["id", "type", "x", "y", "z"] };
                 if self.image {
                     c.extend(["ix", "iy", "iz"]);
                 }
@@ -841,9 +806,9 @@ impl DumpWriter {
         match self.opts.style {
             DumpStyle::Custom => {
                 for (j, c) in cols.iter().enumerate() {
-                    let src = frame.col(c).ok_or_else(|| {
-                        Error::usage(format!("dump column '{c}' is missing from the frame at timestep {}", frame.timestep))
-                    })?;
+                    let src = frame
+                        .col(c)
+                        .ok_or_else(|| Error::usage(format!("dump column '{c}' is missing from the frame at timestep {}", frame.timestep)))?;
                     for r in 0..frame.natoms {
                         table[r * nc + j] = frame.values[r * nc_in + src];
                     }
@@ -851,9 +816,7 @@ impl DumpWriter {
             }
             DumpStyle::Atom => {
                 let need = |n: &str| {
-                    frame.col(n).ok_or_else(|| {
-                        Error::usage(format!("dump atom needs column '{n}' (frame at timestep {})", frame.timestep))
-                    })
+                    frame.col(n).ok_or_else(|| Error::usage(format!("dump atom needs column '{n}' (frame at timestep {})", frame.timestep)))
                 };
                 let (id, ty) = (need("id")?, need("type")?);
                 let xyz = match (frame.col("x"), frame.col("y"), frame.col("z")) {
@@ -865,10 +828,7 @@ impl DumpWriter {
                     _ => None,
                 };
                 if xyz.is_none() && sxyz.is_none() {
-                    return Err(Error::usage(format!(
-                        "dump atom needs columns x y z (or xs ys zs) (frame at timestep {})",
-                        frame.timestep
-                    )));
+                    return Err(Error::usage(format!("dump atom needs columns x y z (or xs ys zs) (frame at timestep {})", frame.timestep)));
                 }
                 let img = [frame.col("ix"), frame.col("iy"), frame.col("iz")];
                 for r in 0..frame.natoms {
@@ -902,11 +862,7 @@ impl DumpWriter {
         for &r in &order {
             let row = &table[r * nc..(r + 1) * nc];
             for (j, &x) in row.iter().enumerate() {
-                let arg = if self.int_col[j] && x.fract() == 0.0 && x.abs() < 9.2e18 {
-                    CArg::Int(x as i64)
-                } else {
-                    CArg::Float(x)
-                };
+                let arg = if self.int_col[j] && x.fract() == 0.0 && x.abs() < 9.2e18 { CArg::Int(x as i64) } else { CArg::Float(x) };
                 self.formats[j].write(&mut self.text, &[arg]).map_err(Error::usage)?;
                 if lig || j + 1 < nc {
                     self.text.push(' ');
@@ -1026,11 +982,7 @@ fn build_formats(cols: &[String], int_col: &[bool], specs: &[FormatSpec]) -> Res
             FormatSpec::Line(l) => {
                 let words: Vec<String> = l.split_whitespace().map(str::to_string).collect();
                 if words.len() < cols.len() {
-                    return Err(Error::usage(format!(
-                        "dump_modify format line \"{l}\" has {} words for {} columns",
-                        words.len(),
-                        cols.len()
-                    )));
+                    return Err(Error::usage(format!("dump_modify format line \"{l}\" has {} words for {} columns", words.len(), cols.len())));
                 }
                 line = Some(words);
             }
@@ -1061,10 +1013,7 @@ fn build_formats(cols: &[String], int_col: &[bool], specs: &[FormatSpec]) -> Res
         };
         let cf = CFormat::parse(&f).map_err(|e| Error::usage(format!("dump_modify format for column '{}': {e}", cols[j])))?;
         if cf.arg_kinds().len() != 1 {
-            return Err(Error::usage(format!(
-                "dump_modify format '{f}' for column '{}' must have exactly one conversion",
-                cols[j]
-            )));
+            return Err(Error::usage(format!("dump_modify format '{f}' for column '{}' must have exactly one conversion", cols[j])));
         }
         out.push(cf);
     }

@@ -74,8 +74,7 @@ pub fn vtk_fields(columns: &[String]) -> Result<([usize; 3], Vec<VtkField>)> {
             }
         }
         if let Some(p) = c.strip_suffix('x') {
-            if !p.is_empty() && j + 2 < columns.len() && columns[j + 1] == format!("{p}y") && columns[j + 2] == format!("{p}z")
-            {
+            if !p.is_empty() && j + 2 < columns.len() && columns[j + 1] == format!("{p}y") && columns[j + 2] == format!("{p}z") {
                 used[j] = true;
                 used[j + 1] = true;
                 used[j + 2] = true;
@@ -198,7 +197,14 @@ pub fn fmt_vtk_xml(x: f64) -> String {
         return "0".into();
     }
     if !x.is_finite() {
-        return if x.is_nan() { "NaN" } else if x > 0.0 { "Infinity" } else { "-Infinity" }.into();
+        return if x.is_nan() {
+            "NaN"
+        } else if x > 0.0 {
+            "Infinity"
+        } else {
+            "-Infinity"
+        }
+        .into();
     }
     if (1e-6..1e21).contains(&x.abs()) {
         // Rust prints the shortest round-trip digits without an exponent
@@ -250,9 +256,13 @@ fn xml_array(o: &mut String, indent: &str, ty: &str, name: &str, ncomp: usize, v
 pub fn format_particles_vtk_xml(frame: &Frame, format: VtkFormat) -> Result<String> {
     let (pts, fields, n, val) = frame_arrays(frame)?;
     let kind = if format == VtkFormat::PolyData { "PolyData" } else { "UnstructuredGrid" };
-    let mut o = format!("<?xml version=\"1.0\"?>\n<VTKFile type=\"{kind}\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n  <{kind}>\n");
+    let mut o = format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"{kind}\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n  <{kind}>\n"
+    );
     if format == VtkFormat::PolyData {
-        o.push_str(&format!("    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"));
+        o.push_str(&format!(
+            "    <Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+        ));
     } else {
         o.push_str(&format!("    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">\n"));
     }
@@ -445,6 +455,5 @@ pub fn format_stl(triangles: &[[[f64; 3]; 3]]) -> String {
 /// Write triangles as an ASCII STL file.
 pub fn write_stl(path: impl AsRef<Path>, triangles: &[[[f64; 3]; 3]]) -> Result<()> {
     let path = path.as_ref();
-    std::fs::write(path, format_stl(triangles))
-        .map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", path.display()), &e))
+    std::fs::write(path, format_stl(triangles)).map_err(|e| Error::io(Span::DUMMY, format!("cannot write '{}'", path.display()), &e))
 }

@@ -282,7 +282,9 @@ mod wide {
         #[cfg(target_feature = "avx512vl")]
         return unsafe { _mm256_maskz_loadu_pd(0b0111, p) };
         #[cfg(not(target_feature = "avx512vl"))]
-        unsafe { _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(_mm_loadu_pd(p)), _mm_load_sd(p.add(2))) }
+        unsafe {
+            _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(_mm_loadu_pd(p)), _mm_load_sd(p.add(2)))
+        }
     }
     /// Four rows of x, y, z (and a lane not read) as x, y and z of four lanes.
     #[inline(always)]
@@ -293,11 +295,7 @@ mod wide {
             let y01 = _mm256_unpackhi_pd(r[0], r[1]);
             let xz23 = _mm256_unpacklo_pd(r[2], r[3]);
             let y23 = _mm256_unpackhi_pd(r[2], r[3]);
-            [
-                _mm256_permute2f128_pd::<0x20>(xz01, xz23),
-                _mm256_permute2f128_pd::<0x20>(y01, y23),
-                _mm256_permute2f128_pd::<0x31>(xz01, xz23),
-            ]
+            [_mm256_permute2f128_pd::<0x20>(xz01, xz23), _mm256_permute2f128_pd::<0x20>(y01, y23), _mm256_permute2f128_pd::<0x31>(xz01, xz23)]
         }
     }
     /// See `Vec3::rows`.

@@ -10,10 +10,10 @@
 //! E_eff = E / (2 (1 - nu^2)) (the material mixed with itself); mindlin
 //! `NULL` gives k_t = 8 G_eff = 8 E / (4 (2 - nu)(1 + nu)).
 
+use super::lanes::{Mask, Real};
 use super::normal::granular::{GranularDamping, GranularNormal};
 use super::tangential::granular::GranularTangential;
 use super::PairParams;
-use super::lanes::{Mask, Real};
 use crate::error::{Error, Result};
 use crate::script::source::Span;
 
@@ -106,9 +106,7 @@ impl Default for LiggghtsSettings {
 
 fn check_len(v: &Option<Vec<f64>>, want: usize, name: &str, span: Span) -> Result<()> {
     match v {
-        Some(x) if x.len() != want => {
-            Err(Error::deck(span, format!("{name} needs {want} values for this number of atom types, got {}", x.len())))
-        }
+        Some(x) if x.len() != want => Err(Error::deck(span, format!("{name} needs {want} values for this number of atom types, got {}", x.len()))),
         _ => Ok(()),
     }
 }
@@ -197,15 +195,7 @@ pub fn liggghts_pair_params(m: &LiggghtsMaterials, s: &LiggghtsSettings, span: S
 /// Kn Kt gamma_n gamma_t xmu dampflag [limit_damping]` (also `fix wall/gran`
 /// with those styles): `kt = None` (NULL) gives 2/7 Kn, `gamma_t = None`
 /// gives gamma_n / 2, dampflag 0 gives gamma_t = 0. Same for all type pairs.
-pub fn lammps_gran_params(
-    kn: f64,
-    kt: Option<f64>,
-    gamma_n: f64,
-    gamma_t: Option<f64>,
-    xmu: f64,
-    dampflag: bool,
-    limit_damping: bool,
-) -> PairParams {
+pub fn lammps_gran_params(kn: f64, kt: Option<f64>, gamma_n: f64, gamma_t: Option<f64>, xmu: f64, dampflag: bool, limit_damping: bool) -> PairParams {
     let mut p = PairParams::default();
     p.kn = kn;
     p.kt = kt.unwrap_or(kn * 2.0 / 7.0);
@@ -239,8 +229,7 @@ pub fn lammps_wall_e_eff_2021(e: f64, nu: f64) -> f64 {
 
 /// LAMMPS Tsuji damping coefficient alpha(e) (pair_granular.cpp polynomial).
 pub fn tsuji_alpha(e: f64) -> f64 {
-    1.2728 - 4.2783 * e + 11.087 * e.powi(2) - 22.348 * e.powi(3) + 27.467 * e.powi(4) - 18.022 * e.powi(5)
-        + 4.8218 * e.powi(6)
+    1.2728 - 4.2783 * e + 11.087 * e.powi(2) - 22.348 * e.powi(3) + 27.467 * e.powi(4) - 18.022 * e.powi(5) + 4.8218 * e.powi(6)
 }
 
 /// Geometric mixing sqrt(a b) (LAMMPS `mix_geom`).

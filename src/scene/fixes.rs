@@ -627,7 +627,6 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
     }))
 }
 
-
 /// `fix ID group ave/time Nevery Nrepeat Nfreq value ... [ave one|running]
 /// [file F] [start S] [mode scalar]`: time averages of global scalars
 /// (`c_ID`, `c_ID[i]`, `f_ID`, `f_ID[i]`, `v_name`), written every Nfreq steps
@@ -770,13 +769,31 @@ pub fn parse_ave_time(id: &str, a: &mut Args, check: bool) -> Result<AveTime> {
                     a.word("value")?;
                 }
             }
-            _ => return Err(Error::deck(w.span, format!("fix ave/time: unknown value or keyword '{t}'")).with_hint("values are c_ID, c_ID[i], f_ID, f_ID[i] or v_name")),
+            _ => {
+                return Err(Error::deck(w.span, format!("fix ave/time: unknown value or keyword '{t}'"))
+                    .with_hint("values are c_ID, c_ID[i], f_ID, f_ID[i] or v_name"))
+            }
         }
     }
     if values.is_empty() {
         return Err(Error::deck(a.end_span(), "fix ave/time: no values"));
     }
-    Ok(AveTime { id: id.to_string(), nevery, nrepeat, nfreq, values, running, start, file, sums: vec![], count: 0, result: vec![], total: vec![], windows: 0, header_written: false })
+    Ok(AveTime {
+        id: id.to_string(),
+        nevery,
+        nrepeat,
+        nfreq,
+        values,
+        running,
+        start,
+        file,
+        sums: vec![],
+        count: 0,
+        result: vec![],
+        total: vec![],
+        windows: 0,
+        header_written: false,
+    })
 }
 
 /// `fix ID group check/timestep/gran N fraction_rayleigh fraction_hertz`
@@ -877,7 +894,16 @@ mod tests {
         let mut p = crate::engine::particles::Particles::default();
         for i in 0..n {
             let mask = if i % 3 == 0 { 3 } else { 1 };
-            p.push(crate::engine::particles::NewParticle { tag: i as i64 + 1, kind: 1, mask, x: V3::zeros(), v: V3::zeros(), omega: V3::zeros(), radius: 1.0, density: 1.0 });
+            p.push(crate::engine::particles::NewParticle {
+                tag: i as i64 + 1,
+                kind: 1,
+                mask,
+                x: V3::zeros(),
+                v: V3::zeros(),
+                omega: V3::zeros(),
+                radius: 1.0,
+                density: 1.0,
+            });
             (p.f[i], p.torque[i]) = (force(i), V3::new(1.0, 2.0, 3.0));
         }
         let stage = Hold { group: 2, removed: fr.removed.clone() };

@@ -18,7 +18,8 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
     let w = a.word("T0")?;
     // the engine hands T0 on as printf's "%f" text (fix_heat_gran.cpp,
     // post_create), so it keeps six decimals
-    let t0: f64 = format!("{:.6}", parse_f64(w)?).parse().map_err(|_| Error::deck(w.span, format!("fix {name}: initial_temperature must be finite")))?;
+    let t0: f64 =
+        format!("{:.6}", parse_f64(w)?).parse().map_err(|_| Error::deck(w.span, format!("fix {name}: initial_temperature must be finite")))?;
     let mut area = ContactArea::Overlap;
     while a.more() {
         // LIGGGHTS reads keywords until the first word it does not know and
@@ -29,7 +30,10 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
         if a.peek().is_some_and(|w| !["contact_area", "area_correction"].contains(&w.text.as_str())) {
             let rest: Vec<String> = a.rest().iter().map(|w| w.text.clone()).collect();
             a.pos += rest.len();
-            s.notes.push((cmd.span, format!("fix {name}: '{}' ignored, as LIGGGHTS 3.8 ignores the words after the last keyword it reads", rest.join(" "))));
+            s.notes.push((
+                cmd.span,
+                format!("fix {name}: '{}' ignored, as LIGGGHTS 3.8 ignores the words after the last keyword it reads", rest.join(" ")),
+            ));
             break;
         }
         let k = a.choice("keyword", &["contact_area", "area_correction"])?;
@@ -59,7 +63,9 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
     let per_type = |prop: &str| -> Result<Vec<f64>> {
         match s.props.get(prop) {
             Some((_, v)) if v.len() >= ntypes => Ok(v[..ntypes].to_vec()),
-            Some((_, v)) => Err(Error::deck(style.span, format!("fix {name}: property/global {prop} has {} values for {ntypes} atom types", v.len()))),
+            Some((_, v)) => {
+                Err(Error::deck(style.span, format!("fix {name}: property/global {prop} has {} values for {ntypes} atom types", v.len())))
+            }
             None => Err(Error::deck(style.span, format!("fix {name} needs the per-type property {prop}"))
                 .with_hint(format!("define it first: fix ID all property/global {prop} peratomtype VALUE..."))),
         }

@@ -48,8 +48,8 @@ use super::args::{bad_keyword, parse_f64, parse_i64, Args};
 use super::Session;
 use crate::engine::domain::Domain;
 use crate::engine::fix::Fix;
-use crate::engine::mesh_surface::SharedMesh;
 use crate::engine::insert::{in_box, is_prime, random_point, region_volume_mc, OverlapGrid};
+use crate::engine::mesh_surface::SharedMesh;
 use crate::engine::particles::{NewParticle, Particles};
 use crate::engine::rng::Park;
 use crate::engine::sim::{Dialect, Sim};
@@ -328,7 +328,11 @@ fn parse_template(s: &Session, id: &str, group: u32, style: &Word, a: &mut Args)
                 let vw = a.word("value")?;
                 let v = parse_f64(vw)?;
                 if v <= 0.0 {
-                    let m = if what == "radius" { "Illegal fix particletemplate/sphere command, radius must be >= 0".to_string() } else { lig(st, id, "density must be >= 0") };
+                    let m = if what == "radius" {
+                        "Illegal fix particletemplate/sphere command, radius must be >= 0".to_string()
+                    } else {
+                        lig(st, id, "density must be >= 0")
+                    };
                     return Err(Error::deck(vw.span, m));
                 }
                 if what == "radius" {
@@ -474,8 +478,7 @@ impl Fix for Distribution {
         &self.style
     }
     fn summary(&self) -> String {
-        let parts: Vec<String> =
-            self.templates.iter().zip(&self.weights).map(|(t, w)| format!("{} {:.4}%", t.id, 100.0 * w)).collect();
+        let parts: Vec<String> = self.templates.iter().zip(&self.weights).map(|(t, w)| format!("{} {:.4}%", t.id, 100.0 * w)).collect();
         format!("{} {}: number fractions {}", self.style, self.id, parts.join(", "))
     }
     fn as_any(&self) -> Option<&dyn std::any::Any> {
@@ -493,8 +496,11 @@ fn parse_distribution(s: &Session, id: &str, group: u32, style: &Word, a: &mut A
         return Err(Error::deck(nw.span, lig(st, id, "illegal number of templates")));
     }
     if a.rest().len() != 2 * n as usize {
-        return Err(Error::deck(nw.span, lig(st, id, "# of templates does not match # of arguments"))
-            .with_hint(format!("expected {} template/weight pairs, found {} words", n, a.rest().len())));
+        return Err(Error::deck(nw.span, lig(st, id, "# of templates does not match # of arguments")).with_hint(format!(
+            "expected {} template/weight pairs, found {} words",
+            n,
+            a.rest().len()
+        )));
     }
     let mut templates = Vec::new();
     let mut given = Vec::new();
@@ -751,11 +757,28 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
     // region/target keywords; a common keyword after those is an error.
     let mut phase2 = false;
     const BASE: &[&str] = &[
-        "distributiontemplate", "maxattempt", "nparticles", "mass", "massrate", "particlerate", "insert_every", "insert_every_time",
-        "every", "start", "overlapcheck", "all_in", "random_distribute", "verbose", "vel", "omega", "orientation",
-        "set_property", "compress_tags",
+        "distributiontemplate",
+        "maxattempt",
+        "nparticles",
+        "mass",
+        "massrate",
+        "particlerate",
+        "insert_every",
+        "insert_every_time",
+        "every",
+        "start",
+        "overlapcheck",
+        "all_in",
+        "random_distribute",
+        "verbose",
+        "vel",
+        "omega",
+        "orientation",
+        "set_property",
+        "compress_tags",
     ];
-    const PACK: &[&str] = &["region", "volumefraction_region", "particles_in_region", "mass_in_region", "ntry_mc", "warn_region", "check_dist_from_subdomain_border"];
+    const PACK: &[&str] =
+        &["region", "volumefraction_region", "particles_in_region", "mass_in_region", "ntry_mc", "warn_region", "check_dist_from_subdomain_border"];
     const STREAM: &[&str] = &["insertion_face", "extrude_length", "duration", "parallel", "ntry_mc"];
     while a.more() {
         let k = a.word("keyword")?;
@@ -803,12 +826,7 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
             }
             "distributiontemplate" => {
                 let w = a.word("distribution id")?;
-                let d = s
-                    .sim
-                    .fixes
-                    .iter()
-                    .find(|f| f.id() == w.text)
-                    .and_then(|f| f.as_any().and_then(|x| x.downcast_ref::<Distribution>()));
+                let d = s.sim.fixes.iter().find(|f| f.id() == w.text).and_then(|f| f.as_any().and_then(|x| x.downcast_ref::<Distribution>()));
                 match d {
                     Some(d) => dist = Some(d.clone()),
                     None => {
@@ -1220,10 +1238,10 @@ impl LiggghtsInsert {
         let v = region_volume_mc(&self.region, domain, &mut r, self.ntry_mc).unwrap_or(0.0);
         self.region_rng = r;
         if v <= 0.0 {
-            return Err(Error::deck(self.span, format!(
-                "fix {} {}: Unable to calculate region volume (region {} is empty or outside the box)",
-                self.style, self.id, self.region.id
-            )));
+            return Err(Error::deck(
+                self.span,
+                format!("fix {} {}: Unable to calculate region volume (region {} is empty or outside the box)", self.style, self.id, self.region.id),
+            ));
         }
         self.region_volume = Some(v);
         Ok(v)
@@ -1420,9 +1438,7 @@ impl LiggghtsInsert {
                 }
                 let rv = self.region_volume.unwrap_or(0.0);
                 let (n, ratio) = match target {
-                    PackTarget::VolumeFraction(f) => {
-                        (((f * rv - vol) / self.dist.vol_expect() + self.rng.uniform()).trunc() as i64, vol / (f * rv))
-                    }
+                    PackTarget::VolumeFraction(f) => (((f * rv - vol) / self.dist.vol_expect() + self.rng.uniform()).trunc() as i64, vol / (f * rv)),
                     PackTarget::Particles(n) => (n - np, np as f64 / n as f64),
                     PackTarget::Mass(m) => (((m - mass) / self.dist.mass_expect() + self.rng.uniform()).trunc() as i64, mass / m),
                 };
@@ -1869,7 +1885,9 @@ fn parse_pour(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args
                 let st = a.choice("diam style", &["one", "range", "poly"]).map_err(|e| {
                     // 2012-era LAMMPS wrote `diam lo hi`
                     if a.prev().is_some_and(|w| super::args::parse_f64(w).is_ok()) {
-                        e.with_hint("2012-era `diam lo hi` is written `diam range lo hi` in current LAMMPS; `demx convert --to lammps` rewrites old decks")
+                        e.with_hint(
+                            "2012-era `diam lo hi` is written `diam range lo hi` in current LAMMPS; `demx convert --to lammps` rewrites old decks",
+                        )
                     } else {
                         e
                     }
@@ -1917,8 +1935,12 @@ fn parse_pour(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut Args
             "ignore" => {}
             "mol" | "molfrac" | "rigid" | "shake" => return Err(Error::unsupported(k.span, format!("fix pour {} (molecules)", k.text))),
             _ => {
-                return Err(bad_keyword(k, "fix pour keyword", &["region", "diam", "dens", "vol", "rate", "vel", "id", "ignore", "mol", "molfrac", "rigid", "shake"])
-                    .with_hint("LAMMPS: Illegal fix pour command"))
+                return Err(bad_keyword(
+                    k,
+                    "fix pour keyword",
+                    &["region", "diam", "dens", "vol", "rate", "vel", "id", "ignore", "mol", "molfrac", "rigid", "shake"],
+                )
+                .with_hint("LAMMPS: Illegal fix pour command"))
             }
         }
     }

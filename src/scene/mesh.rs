@@ -13,15 +13,18 @@ use super::args::{self, Args};
 use super::model::{self, NormalSpec, PairSpec, TangentialSpec};
 use super::Session;
 use crate::engine::fix::{Fix, Hook, Local};
-use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::integrate::CHUNK;
-use crate::engine::mesh_surface::{finnie_increment, resolve_among, resolve_particle, MeshHit, Pose, SharedMesh, Slots, StressSum, SurfaceMesh, TriStress, Wear, DEFAULT_CURVATURE_COS, MESH_SLOTS};
+use crate::engine::kernel::{ContactKernel, ParamTable};
+use crate::engine::mesh_surface::{
+    finnie_increment, resolve_among, resolve_particle, MeshHit, Pose, SharedMesh, Slots, StressSum, SurfaceMesh, TriStress, Wear,
+    DEFAULT_CURVATURE_COS, MESH_SLOTS,
+};
 use crate::engine::output::Dump;
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
-use crate::io::vtk::{MeshArray, MeshVtkOutput, VtkType};
 use crate::geom::mesh::parse_mesh_transforms;
 use crate::geom::{MeshMotion, Region, Triangle};
+use crate::io::vtk::{MeshArray, MeshVtkOutput, VtkType};
 use crate::physics::{Contact, V3};
 use crate::script::{Command, Variables, Word};
 use rayon::prelude::*;
@@ -114,11 +117,7 @@ impl Fix for MeshSurfaceFix {
 
 /// The mesh of `fix mesh/surface` with id `id`, if defined.
 pub fn find_mesh(s: &Session, id: &str) -> Option<SharedMesh> {
-    s.sim
-        .fixes
-        .iter()
-        .filter(|f| f.id() == id)
-        .find_map(|f| f.as_any().and_then(|a| a.downcast_ref::<MeshSurfaceFix>()).map(|m| m.mesh.clone()))
+    s.sim.fixes.iter().filter(|f| f.id() == id).find_map(|f| f.as_any().and_then(|a| a.downcast_ref::<MeshSurfaceFix>()).map(|m| m.mesh.clone()))
 }
 
 fn need_mesh(s: &Session, w: &Word) -> Result<SharedMesh> {
@@ -265,7 +264,22 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Wo
                 return Err(args::bad_keyword(
                     k,
                     &format!("fix {} keyword", style.text),
-                    &["file", "type", "scale", "move", "rotate", "curvature", "heal", "verbose", "precision", "surface_vel", "temperature", "stress", "reference_point", "wear"],
+                    &[
+                        "file",
+                        "type",
+                        "scale",
+                        "move",
+                        "rotate",
+                        "curvature",
+                        "heal",
+                        "verbose",
+                        "precision",
+                        "surface_vel",
+                        "temperature",
+                        "stress",
+                        "reference_point",
+                        "wear",
+                    ],
                 ))
             }
         }
@@ -286,11 +300,8 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Wo
     for (k, t) in tris.iter().enumerate() {
         match seen.get(&key(t)) {
             Some(j) if !heal => {
-                return Err(Error::deck(
-                    file.span,
-                    format!("mesh '{}': elements {j} and {k} are duplicate; bad mesh, cannot continue", file.text),
-                )
-                .with_hint("LIGGGHTS: try re-running with 'heal auto_remove_duplicates'"))
+                return Err(Error::deck(file.span, format!("mesh '{}': elements {j} and {k} are duplicate; bad mesh, cannot continue", file.text))
+                    .with_hint("LIGGGHTS: try re-running with 'heal auto_remove_duplicates'"))
             }
             Some(_) => continue,
             None => {
@@ -304,11 +315,8 @@ fn mesh_surface(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Wo
             for c in 0..3 {
                 let (e1, e2) = (t.e[c].normalize(), t.e[(c + 2) % 3].normalize());
                 if -e1.dot(&e2) > curvature_cos {
-                    return Err(Error::deck(
-                        file.span,
-                        format!("mesh '{}': an angle of element {k} is smaller than the curvature angle", file.text),
-                    )
-                    .with_hint("set 'curvature' lower, or 'curvature_tolerant yes'"));
+                    return Err(Error::deck(file.span, format!("mesh '{}': an angle of element {k} is smaller than the curvature angle", file.text))
+                        .with_hint("set 'curvature' lower, or 'curvature_tolerant yes'"));
                 }
             }
         }
@@ -421,7 +429,6 @@ fn move_mesh(s: &mut Session, cmd: &Command, id: &str, a: &mut Args) -> Result<(
 }
 
 // ---------------------------------------------------------- wall/gran mesh
-
 
 struct WallMesh {
     mesh: SharedMesh,
@@ -666,7 +673,13 @@ impl Fix for WallGranMesh {
                     .map(body)
                     .collect()
             } else {
-                f.chunks_mut(CHUNK).zip(torque.chunks_mut(CHUNK)).zip(data.chunks_mut(CHUNK * len)).zip(used.chunks_mut(CHUNK)).enumerate().map(body).collect()
+                f.chunks_mut(CHUNK)
+                    .zip(torque.chunks_mut(CHUNK))
+                    .zip(data.chunks_mut(CHUNK * len))
+                    .zip(used.chunks_mut(CHUNK))
+                    .enumerate()
+                    .map(body)
+                    .collect()
             };
             let parts = done.into_iter().collect::<Result<Vec<ChunkPush>>>()?;
             if parts.iter().any(|p| p.4) {
@@ -753,7 +766,10 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
     s.need_box(cmd)?;
     s.set_dialect(Dialect::Liggghts);
     let words = a.rest().to_vec();
-    let end = words.iter().position(|w| w.text == "mesh").ok_or_else(|| Error::deck(a.end_span(), "fix wall/gran: missing `mesh n_meshes N meshes ...`"))?;
+    let end = words
+        .iter()
+        .position(|w| w.text == "mesh")
+        .ok_or_else(|| Error::deck(a.end_span(), "fix wall/gran: missing `mesh n_meshes N meshes ...`"))?;
     let mut spec = PairSpec::new(cmd.span, true);
     if end > 0 {
         let model_cmd = Command { words: std::iter::once(cmd.words[0].clone()).chain(words[..end].iter().cloned()).collect(), span: cmd.span };
@@ -774,7 +790,18 @@ fn wall_gran_mesh(s: &mut Session, cmd: &Command, id: &str, group: u32, a: &mut 
         let m = need_mesh(s, w)?;
         let hist_name = format!("mesh_history:{id}:{}", w.text);
         let used_name = format!("{hist_name}:used");
-        meshes.push(WallMesh { mesh: m, hist_name, used_name, near: vec![], start: vec![], anchor: vec![], active: vec![], active_start: vec![], near_at: None, built: None });
+        meshes.push(WallMesh {
+            mesh: m,
+            hist_name,
+            used_name,
+            near: vec![],
+            start: vec![],
+            anchor: vec![],
+            active: vec![],
+            active_start: vec![],
+            near_at: None,
+            built: None,
+        });
         names.push(w.text.clone());
     }
     while a.more() {
@@ -1311,7 +1338,9 @@ pub fn dump_mesh_vtk(s: &Session, cmd: &Command) -> Result<DumpMeshVtk> {
         }
     }
     if !props.iter().any(|&p| p) {
-        return Err(Error::deck(cmd.span, "dump mesh/vtk: no property to dump").with_hint(format!("name one or more of: {}", MESH_VTK_PROPS.join(" "))));
+        return Err(
+            Error::deck(cmd.span, "dump mesh/vtk: no property to dump").with_hint(format!("name one or more of: {}", MESH_VTK_PROPS.join(" ")))
+        );
     }
     if meshes.is_empty() {
         (meshes, names) = all_meshes(s);
@@ -1327,6 +1356,7 @@ pub fn dump_mesh_vtk(s: &Session, cmd: &Command) -> Result<DumpMeshVtk> {
         }
     }
     let chosen: Vec<&str> = MESH_VTK_PROPS.iter().zip(props).filter(|&(_, on)| on).map(|(&p, _)| p).collect();
-    let summary = format!("dump {} mesh/vtk every {} -> {} ({}; meshes {})", d.frames.id, d.frames.every, file.text, chosen.join(" "), names.join(" "));
+    let summary =
+        format!("dump {} mesh/vtk every {} -> {} ({}; meshes {})", d.frames.id, d.frames.every, file.text, chosen.join(" "), names.join(" "));
     Ok(DumpMeshVtk { summary, ..d })
 }

@@ -5,22 +5,22 @@
 //! but not integrated.
 
 pub mod args;
-pub mod fixes;
-pub mod model;
-pub mod setup;
-pub mod outputs;
-pub mod summary;
-pub mod walls;
-pub mod restart;
-pub mod insert;
-pub mod mesh;
-pub mod wind;
-pub mod heat;
-pub mod overrides;
-pub mod velocity;
 pub mod checkpoint;
 pub mod commands;
+pub mod fixes;
+pub mod heat;
+pub mod insert;
+pub mod mesh;
+pub mod model;
+pub mod outputs;
+pub mod overrides;
+pub mod restart;
+pub mod setup;
 pub mod shell;
+pub mod summary;
+pub mod velocity;
+pub mod walls;
+pub mod wind;
 
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{did_you_mean, Error, Result};
@@ -337,7 +337,10 @@ impl Session {
                 match new {
                     Some(r) => f.replace_region(r),
                     None => {
-                        return Err(Error::deck(cmd.words[0].span, format!("fix {} ({}): its region '{id}' was deleted and not defined again", f.id(), f.style())))
+                        return Err(Error::deck(
+                            cmd.words[0].span,
+                            format!("fix {} ({}): its region '{id}' was deleted and not defined again", f.id(), f.style()),
+                        ))
                     }
                 }
             }
@@ -435,10 +438,15 @@ impl Session {
         // there with "Invalid run command N value"
         let max = i64::from(i32::MAX);
         if !upto && !(0..=max).contains(&n) {
-            return Err(Error::deck(cmd.args()[0].span, format!("run: N must be between 0 and {max}, not {n}")).with_hint("LAMMPS and LIGGGHTS: Invalid run command N value"));
+            return Err(Error::deck(cmd.args()[0].span, format!("run: N must be between 0 and {max}, not {n}"))
+                .with_hint("LAMMPS and LIGGGHTS: Invalid run command N value"));
         }
         if upto && n.checked_sub(self.sim.step).is_some_and(|d| d > max) {
-            return Err(Error::deck(cmd.args()[0].span, format!("run upto {n}: {} steps from step {} is more than {max}", n - self.sim.step, self.sim.step)).with_hint("LAMMPS and LIGGGHTS: Invalid run command upto value"));
+            return Err(Error::deck(
+                cmd.args()[0].span,
+                format!("run upto {n}: {} steps from step {} is more than {max}", n - self.sim.step, self.sim.step),
+            )
+            .with_hint("LAMMPS and LIGGGHTS: Invalid run command upto value"));
         }
         let mut steps = if upto { n - self.sim.step } else { n };
         if let Some(m) = self.max_steps {
@@ -480,8 +488,7 @@ impl Session {
             self.sim.log.line("WARNING: No fixes defined, atoms won't move");
         }
         self.sim.guard.timestep = if self.sim.guard.settings.enabled && !self.check {
-            summary::timestep_check(self)
-                .map(|t| crate::engine::guard::TimestepFractions { hertz: t.fraction_hertz, rayleigh: t.fraction_rayleigh })
+            summary::timestep_check(self).map(|t| crate::engine::guard::TimestepFractions { hertz: t.fraction_hertz, rayleigh: t.fraction_rayleigh })
         } else {
             None
         };

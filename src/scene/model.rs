@@ -9,7 +9,10 @@ use super::Session;
 use crate::engine::kernel::{ContactKernel, Laws, ParamTable};
 use crate::engine::sim::{Dialect, PairModel};
 use crate::error::{Error, Result};
-use crate::physics::normal::{self, granular::{GranularDamping, GranularNormal}};
+use crate::physics::normal::{
+    self,
+    granular::{GranularDamping, GranularNormal},
+};
 use crate::physics::tangential::{self, granular::GranularTangential};
 use crate::physics::{CohesionLaw, NoCohesion, NoRolling, NormalLaw, PairParams, RollingLaw, TangentialLaw};
 use crate::script::{Command, Span, Variables, Word};
@@ -579,7 +582,18 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                 return Err(bad_keyword(
                     k,
                     "pair_style gran keyword",
-                    &["tangential", "cohesion", "rolling_friction", "surface", "tangential_damping", "limitForce", "ktToKnUser", "absolute_damping", "torsionTorque", "tangential_reduce"],
+                    &[
+                        "tangential",
+                        "cohesion",
+                        "rolling_friction",
+                        "surface",
+                        "tangential_damping",
+                        "limitForce",
+                        "ktToKnUser",
+                        "absolute_damping",
+                        "torsionTorque",
+                        "tangential_reduce",
+                    ],
                 ))
             }
         }
@@ -771,7 +785,10 @@ fn parse_granular_coeff(a: &mut Args) -> Result<GranularChoice> {
             "limit_damping" => {
                 if let Some(c) = cohesive {
                     // LAMMPS 29 Sep 2021: "Cannot limit damping with DMT model" / "... JKR model"
-                    return Err(Error::deck(k.span, format!("Cannot limit damping with {} model", if c == CohesiveNormal::Dmt { "DMT" } else { "JKR" })));
+                    return Err(Error::deck(
+                        k.span,
+                        format!("Cannot limit damping with {} model", if c == CohesiveNormal::Dmt { "DMT" } else { "JKR" }),
+                    ));
                 }
                 pp.limit_damping = 1.0
             }
@@ -848,7 +865,10 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                     Some(v) => {
                         let n = v.first().copied().unwrap_or(0.0) as usize;
                         if n != nt || v.len() != 1 + n * n {
-                            return Err(Error::deck(span, format!("property/global {name} must be `peratomtypepair {nt}` followed by {} values", nt * nt)));
+                            return Err(Error::deck(
+                                span,
+                                format!("property/global {name} must be `peratomtypepair {nt}` followed by {} values", nt * nt),
+                            ));
                         }
                         Ok(Some(v[1..].to_vec()))
                     }
@@ -924,7 +944,11 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                         .with_hint("add `hard_particles yes` before the pair_style"));
                 }
             }
-            let settings = LiggghtsSettings { tangential_damping: spec.tangential_damping, limit_force: spec.limit_damping, units_si: s.units == super::Units::Si && !s.soft_particles };
+            let settings = LiggghtsSettings {
+                tangential_damping: spec.tangential_damping,
+                limit_force: spec.limit_damping,
+                units_si: s.units == super::Units::Si && !s.soft_particles,
+            };
             let mut table = liggghts_pair_params(&m, &settings, span)?;
             if spec.normal == NormalSpec::PaperViscoelastic {
                 let v_ref = scalar("restitutionReferenceVelocity").unwrap_or(0.0);

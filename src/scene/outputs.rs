@@ -7,7 +7,7 @@ use crate::engine::compute::{Compute, ComputeKind};
 use crate::engine::output::{Dump, LostPolicy};
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
-use crate::io::dump::{DumpOptions, DumpWriter, Engine, Frame, FormatSpec, SortBy};
+use crate::io::dump::{DumpOptions, DumpWriter, Engine, FormatSpec, Frame, SortBy};
 use crate::script::{Command, Variables};
 
 /// Execute an output command.
@@ -25,7 +25,8 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             // ("Illegal thermo command"); `thermo 0` (first and last step
             // only) is theirs too
             if !(0..=i64::from(i32::MAX)).contains(&every) {
-                return Err(Error::deck(w.span, format!("thermo: N must be between 0 and {}, not {every}", i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Illegal thermo command"));
+                return Err(Error::deck(w.span, format!("thermo: N must be between 0 and {}, not {every}", i32::MAX))
+                    .with_hint("LAMMPS and LIGGGHTS: Illegal thermo command"));
             }
             s.sim.thermo.every = every;
             Ok(())
@@ -121,7 +122,12 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
         "write_dump" => write_dump(s, cmd),
         "dump_modify" => {
             let w = a.word("dump id")?;
-            let k = s.sim.dumps.iter().position(|d| d.id() == w.text).ok_or_else(|| Error::deck(w.span, format!("dump_modify: dump '{}' does not exist", w.text)))?;
+            let k = s
+                .sim
+                .dumps
+                .iter()
+                .position(|d| d.id() == w.text)
+                .ok_or_else(|| Error::deck(w.span, format!("dump_modify: dump '{}' does not exist", w.text)))?;
             let rest = a.rest();
             s.sim.dumps[k].modify(rest)
         }
@@ -146,7 +152,45 @@ fn check_thermo_keyword(s: &Session, w: &crate::script::Word) -> Result<()> {
     if crate::engine::output::thermo_keyword(&s.sim, k).is_some() || crate::engine::output::TENSOR_KEYWORDS.contains(&k) {
         return Ok(());
     }
-    const OTHER: &[&str] = &["enthalpy", "ecouple", "econserve", "xy", "xz", "yz", "fmax", "fnorm", "part", "timeremain", "tpcpu", "lat", "bonds", "angles", "dihedrals", "impropers", "cella", "cellb", "cellc", "cellalpha", "cellbeta", "cellgamma", "evdwl", "ecoul", "epair", "ebond", "eangle", "edihed", "eimp", "emol", "elong", "etail", "xlat", "ylat", "zlat", "nbuild", "ndanger"];
+    const OTHER: &[&str] = &[
+        "enthalpy",
+        "ecouple",
+        "econserve",
+        "xy",
+        "xz",
+        "yz",
+        "fmax",
+        "fnorm",
+        "part",
+        "timeremain",
+        "tpcpu",
+        "lat",
+        "bonds",
+        "angles",
+        "dihedrals",
+        "impropers",
+        "cella",
+        "cellb",
+        "cellc",
+        "cellalpha",
+        "cellbeta",
+        "cellgamma",
+        "evdwl",
+        "ecoul",
+        "epair",
+        "ebond",
+        "eangle",
+        "edihed",
+        "eimp",
+        "emol",
+        "elong",
+        "etail",
+        "xlat",
+        "ylat",
+        "zlat",
+        "nbuild",
+        "ndanger",
+    ];
     if OTHER.contains(&k) {
         return Err(Error::unsupported(w.span, format!("thermo keyword {k}")));
     }
@@ -228,8 +272,40 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
 fn is_atom_property_name(n: &str) -> bool {
     matches!(
         n,
-        "id" | "type" | "mass" | "radius" | "diameter" | "density" | "x" | "y" | "z" | "xu" | "yu" | "zu" | "xs" | "ys" | "zs" | "ix" | "iy" | "iz" | "vx"
-            | "vy" | "vz" | "fx" | "fy" | "fz" | "omegax" | "omegay" | "omegaz" | "tqx" | "tqy" | "tqz" | "angmomx" | "angmomy" | "angmomz" | "mol" | "q"
+        "id" | "type"
+            | "mass"
+            | "radius"
+            | "diameter"
+            | "density"
+            | "x"
+            | "y"
+            | "z"
+            | "xu"
+            | "yu"
+            | "zu"
+            | "xs"
+            | "ys"
+            | "zs"
+            | "ix"
+            | "iy"
+            | "iz"
+            | "vx"
+            | "vy"
+            | "vz"
+            | "fx"
+            | "fy"
+            | "fz"
+            | "omegax"
+            | "omegay"
+            | "omegaz"
+            | "tqx"
+            | "tqy"
+            | "tqz"
+            | "angmomx"
+            | "angmomy"
+            | "angmomz"
+            | "mol"
+            | "q"
     )
 }
 
@@ -467,7 +543,13 @@ impl DumpText {
                 "label" | "element" | "region" | "thresh" | "refresh" | "fileper" | "nfile" => {
                     return Err(Error::unsupported(w.span, format!("dump_modify {}", w.text)));
                 }
-                _ => return Err(bad_keyword(w, "dump_modify keyword", &["format", "sort", "scale", "image", "first", "append", "pad", "every", "flush"])),
+                _ => {
+                    return Err(bad_keyword(
+                        w,
+                        "dump_modify keyword",
+                        &["format", "sort", "scale", "image", "first", "append", "pad", "every", "flush"],
+                    ))
+                }
             }
         }
         // a reopened writer picks the new options up
@@ -539,7 +621,9 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args, one_off: bool) -> 
     // LAMMPS 29 Sep 2021 and LIGGGHTS 3.8 stop on N <= 0 ("Invalid dump
     // frequency"); demx wrote no file and went on. N is an int there.
     if !one_off && !(1..=i64::from(i32::MAX)).contains(&every) {
-        return Err(a.err_prev(format!("dump {}: N must be between 1 and {}, not {every}", id.text, i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Invalid dump frequency"));
+        return Err(a
+            .err_prev(format!("dump {}: N must be between 1 and {}, not {every}", id.text, i32::MAX))
+            .with_hint("LAMMPS and LIGGGHTS: Invalid dump frequency"));
     }
     let file = a.word("file")?;
     let engine = if s.sim.dialect == Dialect::Liggghts { Engine::Liggghts } else { Engine::Lammps };

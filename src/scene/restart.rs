@@ -134,7 +134,17 @@ impl RestartState {
             density: p.density.clone(),
             image: p.image.clone(),
             frozen: p.frozen.clone(),
-            extra: p.extra.iter().map(|e| Extra { name: e.name.clone(), width: e.width, data: e.data.clone(), default: e.default.clone(), from_position: e.from_position }).collect(),
+            extra: p
+                .extra
+                .iter()
+                .map(|e| Extra {
+                    name: e.name.clone(),
+                    width: e.width,
+                    data: e.data.clone(),
+                    default: e.default.clone(),
+                    from_position: e.from_position,
+                })
+                .collect(),
             f: p.f.iter().map(v3).collect(),
             torque: p.torque.iter().map(v3).collect(),
             pair_keys: pairs.keys.clone(),
@@ -243,7 +253,11 @@ impl RestartState {
             p.image[i] = self.image[i];
             p.frozen[i] = self.frozen[i];
         }
-        p.extra = self.extra.into_iter().map(|e| PerAtom { name: e.name, width: e.width, data: e.data, default: e.default, from_position: e.from_position }).collect();
+        p.extra = self
+            .extra
+            .into_iter()
+            .map(|e| PerAtom { name: e.name, width: e.width, data: e.data, default: e.default, from_position: e.from_position })
+            .collect();
         let m = self.pair_keys.len();
         let consistent = self.pair_a.len() == m
             && self.pair_b.len() == m

@@ -3,9 +3,9 @@
 
 use super::args::{bad_keyword, parse_f64, Args};
 use super::{Session, Units};
-use crate::engine::sim::Dialect;
 use crate::engine::domain::{Domain, Side};
 use crate::engine::particles::NewParticle;
+use crate::engine::sim::Dialect;
 use crate::error::{Error, Result};
 use crate::geom::{parse_lattice, parse_region, Region, RegionParseCtx};
 use crate::physics::V3;
@@ -53,9 +53,36 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                         Err(Error::unsupported(st.span, format!("atom_style {}", cmd.text().trim_start_matches("atom_style "))))
                     }
                 }
-                "atomic" | "bond" | "angle" | "molecular" | "full" | "charge" | "body" | "line" | "tri" | "ellipsoid" | "superquadric"
-                | "dipole" | "bpm/sphere" | "sph" | "peri" | "template" | "spin" | "wavepacket" | "electron" | "dpd" | "edpd" | "mdpd"
-                | "tdpd" | "oxdna" | "dielectric" | "granular/multisphere" | "convexhull" => Err(Error::unsupported(st.span, format!("atom_style {}", st.text)).with_hint("demx simulates spheres: atom_style sphere or granular")),
+                "atomic"
+                | "bond"
+                | "angle"
+                | "molecular"
+                | "full"
+                | "charge"
+                | "body"
+                | "line"
+                | "tri"
+                | "ellipsoid"
+                | "superquadric"
+                | "dipole"
+                | "bpm/sphere"
+                | "sph"
+                | "peri"
+                | "template"
+                | "spin"
+                | "wavepacket"
+                | "electron"
+                | "dpd"
+                | "edpd"
+                | "mdpd"
+                | "tdpd"
+                | "oxdna"
+                | "dielectric"
+                | "granular/multisphere"
+                | "convexhull" => {
+                    Err(Error::unsupported(st.span, format!("atom_style {}", st.text))
+                        .with_hint("demx simulates spheres: atom_style sphere or granular"))
+                }
                 _ => Err(bad_keyword(st, "atom style", &["sphere", "granular"])),
             }
         }
@@ -67,10 +94,15 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                 let pair = match chars.len() {
                     1 => [chars[0], chars[0]],
                     2 => [chars[0], chars[1]],
-                    _ => return Err(Error::deck(w.span, format!("illegal boundary '{}'", w.text)).with_hint("use p, f, s, m or two of them such as fm")),
+                    _ => {
+                        return Err(
+                            Error::deck(w.span, format!("illegal boundary '{}'", w.text)).with_hint("use p, f, s, m or two of them such as fm")
+                        )
+                    }
                 };
                 for k in 0..2 {
-                    sides[d][k] = Side::from_char(pair[k]).ok_or_else(|| Error::deck(w.span, format!("illegal boundary letter '{}' (expected p, f, s, m)", pair[k])))?;
+                    sides[d][k] = Side::from_char(pair[k])
+                        .ok_or_else(|| Error::deck(w.span, format!("illegal boundary letter '{}' (expected p, f, s, m)", pair[k])))?;
                 }
                 if (sides[d][0] == Side::Periodic) != (sides[d][1] == Side::Periodic) {
                     return Err(Error::deck(w.span, "both sides of a periodic dimension must be periodic"));
@@ -95,7 +127,9 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             // both engines stop on a negative skin ("Illegal neighbor
             // command"); demx's bins then grew without bound
             if skin < 0.0 {
-                return Err(a.err_prev(format!("neighbor: skin must be >= 0, not {skin}")).with_hint("LAMMPS and LIGGGHTS: Illegal neighbor command"));
+                return Err(a
+                    .err_prev(format!("neighbor: skin must be >= 0, not {skin}"))
+                    .with_hint("LAMMPS and LIGGGHTS: Illegal neighbor command"));
             }
             s.sim.neigh.skin = skin;
             let st = a.word("neighbor style")?;
@@ -141,7 +175,9 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
                     "contact_distance_factor" => {
                         a.f64("factor")?;
                     }
-                    _ => return Err(bad_keyword(k, "neigh_modify keyword", &["delay", "every", "check", "once", "page", "one", "exclude", "binsize"])),
+                    _ => {
+                        return Err(bad_keyword(k, "neigh_modify keyword", &["delay", "every", "check", "once", "page", "one", "exclude", "binsize"]))
+                    }
                 }
             }
             Ok(())
@@ -175,7 +211,11 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             // each run's start, takes the new definition then (or stops the
             // run if there is none): see `Session::refresh_regions`.
             let w = a.word("region id")?;
-            let k = s.regions.iter().position(|r| r.id == w.text).ok_or_else(|| Error::deck(w.span, format!("region delete: region '{}' does not exist", w.text)))?;
+            let k = s
+                .regions
+                .iter()
+                .position(|r| r.id == w.text)
+                .ok_or_else(|| Error::deck(w.span, format!("region delete: region '{}' does not exist", w.text)))?;
             s.regions.remove(k);
             s.deleted_regions.push(w.text.clone());
             Ok(())
@@ -211,7 +251,11 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             // 80001600008 bytes for array neigh:cutneighsq" for 1e5 types
             let bytes = 2.0 * ((n + 1) as f64).powi(2) * std::mem::size_of::<crate::physics::PairParams>() as f64;
             if !crate::limits::fits(bytes) {
-                return Err(a.err_prev(format!("create_box: {n} atom types need {} for the type-pair coefficient tables; {}", crate::limits::human(bytes), crate::limits::machine())));
+                return Err(a.err_prev(format!(
+                    "create_box: {n} atom types need {} for the type-pair coefficient tables; {}",
+                    crate::limits::human(bytes),
+                    crate::limits::machine()
+                )));
             }
             let rw = a.word("region")?;
             let r = region(s, rw)?;
@@ -219,7 +263,11 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             // both engines: "Box bounds are invalid or missing"
             if let Some(d) = (0..3).find(|&d| hi[d].is_nan() || lo[d].is_nan() || hi[d] <= lo[d]) {
                 let axis = ["x", "y", "z"][d];
-                return Err(Error::deck(rw.span, format!("create_box: region '{}' is empty in {axis} ({axis}lo {} >= {axis}hi {})", rw.text, lo[d], hi[d])).with_hint("LAMMPS and LIGGGHTS: Box bounds are invalid or missing"));
+                return Err(Error::deck(
+                    rw.span,
+                    format!("create_box: region '{}' is empty in {axis} ({axis}lo {} >= {axis}hi {})", rw.text, lo[d], hi[d]),
+                )
+                .with_hint("LAMMPS and LIGGGHTS: Box bounds are invalid or missing"));
             }
             while a.more() {
                 // LIGGGHTS/LAMMPS extra keywords (bond/types, extra/...): accept numbers
@@ -326,15 +374,23 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             // 32-bit ints and stop on N < 0 or seed <= 0 ("Illegal
             // create_atoms command"); demx created nothing and went on
             if !(0..=i64::from(i32::MAX)).contains(&n) {
-                return Err(a.err_prev(format!("create_atoms random: N must be between 0 and {}, not {n}", i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Illegal create_atoms command"));
+                return Err(a
+                    .err_prev(format!("create_atoms random: N must be between 0 and {}, not {n}", i32::MAX))
+                    .with_hint("LAMMPS and LIGGGHTS: Illegal create_atoms command"));
             }
             let bytes = (s.sim.particles.len() as f64 + n as f64) * crate::limits::BYTES_PER_PARTICLE;
             if !crate::limits::fits(bytes) {
-                return Err(a.err_prev(format!("create_atoms random: {n} particles need at least {}; {}", crate::limits::human(bytes), crate::limits::machine())));
+                return Err(a.err_prev(format!(
+                    "create_atoms random: {n} particles need at least {}; {}",
+                    crate::limits::human(bytes),
+                    crate::limits::machine()
+                )));
             }
             let seed = a.i64("seed")?;
             if !(1..=i64::from(i32::MAX)).contains(&seed) {
-                return Err(a.err_prev(format!("create_atoms random: seed must be between 1 and {}, not {seed}", i32::MAX)).with_hint("LAMMPS and LIGGGHTS: Illegal create_atoms command"));
+                return Err(a
+                    .err_prev(format!("create_atoms random: seed must be between 1 and {}, not {seed}", i32::MAX))
+                    .with_hint("LAMMPS and LIGGGHTS: Illegal create_atoms command"));
             }
             let rw = a.word("region")?;
             if rw.text != "NULL" {
@@ -375,18 +431,22 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         points[0] = points[0].component_mul(&sp);
     }
     if style.text == "box" || style.text == "region" {
-        let lat = s.lattice.as_ref().ok_or_else(|| Error::deck(style.span, "create_atoms: no lattice defined").with_hint("define one with the lattice command"))?;
+        let lat = s
+            .lattice
+            .as_ref()
+            .ok_or_else(|| Error::deck(style.span, "create_atoms: no lattice defined").with_hint("define one with the lattice command"))?;
         let periodic = [dom.periodic(0), dom.periodic(1), dom.periodic(2)];
         let filter = region_filter.clone();
         let f = move |p: V3| filter.as_ref().map_or(true, |r| r.contains(p));
-        let pts = lat
-            .create_points(V3::from(dom.lo), V3::from(dom.hi), periodic, Some(&f))
-            .map_err(|e| Error::deck(style.span, e.message()))?;
+        let pts = lat.create_points(V3::from(dom.lo), V3::from(dom.hi), periodic, Some(&f)).map_err(|e| Error::deck(style.span, e.message()))?;
         points = pts.into_iter().map(|(p, _)| p).collect();
     }
     let bytes = (s.sim.particles.len() + points.len()) as f64 * crate::limits::BYTES_PER_PARTICLE;
     if !crate::limits::fits(bytes) {
-        return Err(Error::deck(style.span, format!("create_atoms: {} particles need at least {}; {}", points.len(), crate::limits::human(bytes), crate::limits::machine())));
+        return Err(Error::deck(
+            style.span,
+            format!("create_atoms: {} particles need at least {}; {}", points.len(), crate::limits::human(bytes), crate::limits::machine()),
+        ));
     }
     // LAMMPS default diameter 1, density 1 for atom_style sphere
     let mut tag = s.sim.particles.max_tag();
@@ -413,7 +473,13 @@ fn change_box(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
                 for d in 0..3 {
                     let w = a.word("boundary")?;
                     let cs: Vec<char> = w.text.chars().collect();
-                    let pair = if cs.len() == 1 { [cs[0], cs[0]] } else if cs.len() == 2 { [cs[0], cs[1]] } else { return Err(Error::deck(w.span, "illegal boundary")) };
+                    let pair = if cs.len() == 1 {
+                        [cs[0], cs[0]]
+                    } else if cs.len() == 2 {
+                        [cs[0], cs[1]]
+                    } else {
+                        return Err(Error::deck(w.span, "illegal boundary"));
+                    };
                     for q in 0..2 {
                         sides[d][q] = Side::from_char(pair[q]).ok_or_else(|| Error::deck(w.span, "illegal boundary letter"))?;
                     }
@@ -545,7 +611,13 @@ fn group_command(s: &mut Session, cmd: &Command, a: &mut Args, vars: &Variables)
             }
         }
         "dynamic" | "static" | "include" => return Err(Error::unsupported(style.span, format!("group {}", style.text))),
-        _ => return Err(bad_keyword(style, "group style", &["type", "id", "region", "empty", "clear", "subtract", "union", "intersect", "variable", "delete"])),
+        _ => {
+            return Err(bad_keyword(
+                style,
+                "group style",
+                &["type", "id", "region", "empty", "clear", "subtract", "union", "intersect", "variable", "delete"],
+            ))
+        }
     }
     let _ = cmd;
     let p = &mut s.sim.particles;
@@ -589,10 +661,12 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
     let select: Vec<bool> = match style.text.as_str() {
         "atom" | "type" => {
             let (lo, hi, _) = parse_range(what)?;
-            (0..p.len()).map(|i| {
-                let f = if style.text == "atom" { p.tag[i] } else { p.kind[i] as i64 };
-                f >= lo && f <= hi
-            }).collect()
+            (0..p.len())
+                .map(|i| {
+                    let f = if style.text == "atom" { p.tag[i] } else { p.kind[i] as i64 };
+                    f >= lo && f <= hi
+                })
+                .collect()
         }
         "group" => {
             let b = s.group(what)?;
@@ -672,7 +746,8 @@ fn set_command(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         };
         if let Some(why) = bad {
             let what = if k.text == "type" { "value" } else { k.text.as_str() };
-            return Err(Error::deck(v.span, format!("set {}: {why}, not {}", k.text, v.text)).with_hint(format!("LAMMPS and LIGGGHTS: Invalid {what} in set command")));
+            return Err(Error::deck(v.span, format!("set {}: {why}, not {}", k.text, v.text))
+                .with_hint(format!("LAMMPS and LIGGGHTS: Invalid {what} in set command")));
         }
         // LAMMPS's `set diameter` keeps the mass ("does not adjust the
         // particle mass", set command doc); LIGGGHTS's keeps the density
@@ -786,11 +861,8 @@ fn velocity_command(s: &mut Session, cmd: &Command, a: &mut Args, vars: &Variabl
             if a.more() && a.choice("keyword", &["rigid"])?.text == "rigid" {
                 return Err(Error::unsupported(a.prev().map_or(cmd.span, |w| w.span), "velocity zero ... rigid"));
             }
-            let done = if k.text == "linear" {
-                super::velocity::zero_momentum(&mut s.sim, bit)
-            } else {
-                super::velocity::zero_rotation(&mut s.sim, bit)
-            };
+            let done =
+                if k.text == "linear" { super::velocity::zero_momentum(&mut s.sim, bit) } else { super::velocity::zero_rotation(&mut s.sim, bit) };
             done.map_err(|e| Error::deck(k.span, e))
         }
         "create" | "scale" => super::velocity::thermal(s, cmd, style, a, bit),
@@ -893,24 +965,102 @@ fn overlap_victims(p: &crate::engine::particles::Particles, cut: f64, g1: u32, g
 /// Fix styles of LIGGGHTS 3.8 and LAMMPS that demx knows by name but does not
 /// run yet: they get exit 3 naming them, unknown words a did-you-mean error.
 const ENGINE_FIX_STYLES: &[&str] = &[
-    "mesh/surface/stress/servo", "couple/cfd", "couple/cfd/force", "couple/cfd/force/implicit",
-    "multisphere", "particletemplate/multisphere", "particletemplate/superquadric",
-    "massflow/mesh", "ave/euler", "property/atom/tracer", "property/atom/tracer/stream", "wall/region/sph", "insert/pack/dense",
-    "nve/sphere/omp", "ave/chunk", "ave/atom", "ave/histo", "ave/correlate", "deform", "rigid", "rigid/small", "spring", "langevin",
-    "nvt", "npt", "nph", "wall/reflect", "wall/region", "store/state", "heat/flow", "temp/rescale", "dt/reset", "adapt",
-    "python/invoke", "wiggle/mesh", "mesh/gran", "recenter", "setforce/region", "lineforce", "planeforce", "efield", "wall/lj93",
-    "nve/limit", "nve/asphere", "bond/create", "bond/break", "wall/gran/hertz/history", "wall/gran/hooke/history", "wall/gran/hooke",
-    "pour/legacy", "pour/dev", "move/mesh/gran", "heat/radiation", "nve/superquadric", "particledistribution/discrete/numberbased",
-    "particledistribution/discrete/massbased", "insert/stream/predefined", "contactproperty/atom", "contacthistory", "sph",
-    "diam/max", "box/relax", "momentum", "viscous/sphere", "damping/cundall", "wall/gran/old",
+    "mesh/surface/stress/servo",
+    "couple/cfd",
+    "couple/cfd/force",
+    "couple/cfd/force/implicit",
+    "multisphere",
+    "particletemplate/multisphere",
+    "particletemplate/superquadric",
+    "massflow/mesh",
+    "ave/euler",
+    "property/atom/tracer",
+    "property/atom/tracer/stream",
+    "wall/region/sph",
+    "insert/pack/dense",
+    "nve/sphere/omp",
+    "ave/chunk",
+    "ave/atom",
+    "ave/histo",
+    "ave/correlate",
+    "deform",
+    "rigid",
+    "rigid/small",
+    "spring",
+    "langevin",
+    "nvt",
+    "npt",
+    "nph",
+    "wall/reflect",
+    "wall/region",
+    "store/state",
+    "heat/flow",
+    "temp/rescale",
+    "dt/reset",
+    "adapt",
+    "python/invoke",
+    "wiggle/mesh",
+    "mesh/gran",
+    "recenter",
+    "setforce/region",
+    "lineforce",
+    "planeforce",
+    "efield",
+    "wall/lj93",
+    "nve/limit",
+    "nve/asphere",
+    "bond/create",
+    "bond/break",
+    "wall/gran/hertz/history",
+    "wall/gran/hooke/history",
+    "wall/gran/hooke",
+    "pour/legacy",
+    "pour/dev",
+    "move/mesh/gran",
+    "heat/radiation",
+    "nve/superquadric",
+    "particledistribution/discrete/numberbased",
+    "particledistribution/discrete/massbased",
+    "insert/stream/predefined",
+    "contactproperty/atom",
+    "contacthistory",
+    "sph",
+    "diam/max",
+    "box/relax",
+    "momentum",
+    "viscous/sphere",
+    "damping/cundall",
+    "wall/gran/old",
 ];
 
 /// Styles demx runs through the modules below.
 const DEMX_FIX_STYLES: &[&str] = &[
-    "wall/gran", "wall/gran/region", "mesh/surface", "mesh/surface/planar", "move/mesh", "insert/pack", "insert/stream",
-    "insert/rate/region", "particletemplate/sphere", "particledistribution/discrete", "pour", "aeolian/wind", "nve/sphere",
-    "nve", "gravity", "freeze", "addforce", "setforce", "viscous", "print", "ave/time", "property/global", "property/atom",
-    "heat/gran", "heat/gran/conduction", "mesh/surface/stress",
+    "wall/gran",
+    "wall/gran/region",
+    "mesh/surface",
+    "mesh/surface/planar",
+    "move/mesh",
+    "insert/pack",
+    "insert/stream",
+    "insert/rate/region",
+    "particletemplate/sphere",
+    "particledistribution/discrete",
+    "pour",
+    "aeolian/wind",
+    "nve/sphere",
+    "nve",
+    "gravity",
+    "freeze",
+    "addforce",
+    "setforce",
+    "viscous",
+    "print",
+    "ave/time",
+    "property/global",
+    "property/atom",
+    "heat/gran",
+    "heat/gran/conduction",
+    "mesh/surface/stress",
 ];
 
 /// Fixes that need geometry, insertion or wind machinery; everything else
@@ -923,7 +1073,12 @@ pub fn extended_fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style:
         }
         "aeolian/wind" => super::wind::fix(s, cmd, id, group, style, a, vars),
         "heat/gran" | "heat/gran/conduction" => super::heat::fix(s, cmd, id, group, style, a),
-        t if ENGINE_FIX_STYLES.contains(&t) || DEMX_FIX_STYLES.contains(&t) || t.starts_with("insert/") || t.starts_with("particle") || t == "adapt" => {
+        t if ENGINE_FIX_STYLES.contains(&t)
+            || DEMX_FIX_STYLES.contains(&t)
+            || t.starts_with("insert/")
+            || t.starts_with("particle")
+            || t == "adapt" =>
+        {
             super::insert::fix(s, cmd, id, group, style, a, vars)
         }
         t => {

@@ -249,7 +249,14 @@ pub fn timestep_check(s: &Session) -> Option<TimestepCheck> {
             let tc = std::f64::consts::PI * (m_eff / kn).sqrt();
             (tc, tc)
         };
-        let c = TimestepCheck { rayleigh_time: tr, hertz_time: th, impact_speed: v, fraction_rayleigh: dt / tr, fraction_hertz: dt / th, particle: (r, rho) };
+        let c = TimestepCheck {
+            rayleigh_time: tr,
+            hertz_time: th,
+            impact_speed: v,
+            fraction_rayleigh: dt / tr,
+            fraction_hertz: dt / th,
+            particle: (r, rho),
+        };
         if best.as_ref().map_or(true, |b| c.fraction_rayleigh.max(c.fraction_hertz) > b.fraction_rayleigh.max(b.fraction_hertz)) {
             best = Some(c);
         }
@@ -260,7 +267,8 @@ pub fn timestep_check(s: &Session) -> Option<TimestepCheck> {
 impl Summary {
     /// Collect from a session after the deck ran in check mode.
     pub fn of(s: &Session) -> Summary {
-        let domain = s.sim.domain.as_ref().map(|d| serde_json::json!({"lo": d.lo, "hi": d.hi, "boundary": d.boundary_strings(), "dimension": d.dimension}));
+        let domain =
+            s.sim.domain.as_ref().map(|d| serde_json::json!({"lo": d.lo, "hi": d.hi, "boundary": d.boundary_strings(), "dimension": d.dimension}));
         let contact = match &s.pair {
             Some(p) => p.summary() + "; wind: none",
             None => "none (no pair_style)".to_string(),

@@ -60,9 +60,12 @@ fn options(s: &Session, a: &mut Args) -> Result<Options> {
             }
             "temp" => {
                 let id = a.word("temperature compute ID")?;
-                let c = s.sim.computes.iter().find(|c| c.id == id.text).ok_or_else(|| {
-                    Error::deck(id.span, format!("compute '{}' does not exist", id.text))
-                })?;
+                let c = s
+                    .sim
+                    .computes
+                    .iter()
+                    .find(|c| c.id == id.text)
+                    .ok_or_else(|| Error::deck(id.span, format!("compute '{}' does not exist", id.text)))?;
                 if c.style != "temp" {
                     return Err(Error::unsupported(id.span, format!("velocity temp with a compute of style {}", c.style)));
                 }
@@ -283,21 +286,9 @@ fn omega(l: V3, i: &[[f64; 3]; 3]) -> V3 {
         - i[2][0] * i[1][1] * i[0][2];
     if det > EPSILON {
         let mut inv = [
-            [
-                i[1][1] * i[2][2] - i[1][2] * i[2][1],
-                -(i[0][1] * i[2][2] - i[0][2] * i[2][1]),
-                i[0][1] * i[1][2] - i[0][2] * i[1][1],
-            ],
-            [
-                -(i[1][0] * i[2][2] - i[1][2] * i[2][0]),
-                i[0][0] * i[2][2] - i[0][2] * i[2][0],
-                -(i[0][0] * i[1][2] - i[0][2] * i[1][0]),
-            ],
-            [
-                i[1][0] * i[2][1] - i[1][1] * i[2][0],
-                -(i[0][0] * i[2][1] - i[0][1] * i[2][0]),
-                i[0][0] * i[1][1] - i[0][1] * i[1][0],
-            ],
+            [i[1][1] * i[2][2] - i[1][2] * i[2][1], -(i[0][1] * i[2][2] - i[0][2] * i[2][1]), i[0][1] * i[1][2] - i[0][2] * i[1][1]],
+            [-(i[1][0] * i[2][2] - i[1][2] * i[2][0]), i[0][0] * i[2][2] - i[0][2] * i[2][0], -(i[0][0] * i[1][2] - i[0][2] * i[1][0])],
+            [i[1][0] * i[2][1] - i[1][1] * i[2][0], -(i[0][0] * i[2][1] - i[0][1] * i[2][0]), i[0][0] * i[1][1] - i[0][1] * i[1][0]],
         ];
         for row in inv.iter_mut() {
             for v in row.iter_mut() {

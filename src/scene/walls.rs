@@ -7,16 +7,16 @@ use super::args::Args;
 use super::model::{self, NormalSpec, PairSpec, TangentialSpec};
 use super::Session;
 use crate::engine::fix::{Chunk, Fix, Hook, Local, Stage};
+use crate::engine::integrate::CHUNK;
 use crate::engine::kernel::{ContactKernel, ParamTable};
 use crate::engine::sim::{Dialect, Sim};
 use crate::error::{Error, Result};
 use crate::geom::{PrimitiveWall, WallMotion};
+use crate::physics::lanes::LANES;
 use crate::physics::normal::granular::{GranularDamping, GranularNormal};
 use crate::physics::normal::jkr::jkr_pulloff_overlap;
-use crate::physics::lanes::LANES;
 use crate::physics::{Contact, ContactOut, PairParams, V3};
 use crate::script::{Command, Variables, Word};
-use crate::engine::integrate::CHUNK;
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -132,7 +132,22 @@ impl WallLaws {
     ) {
         let wc = self.width.max(1);
         let mut scratch = vec![0.0; LANES * self.width];
-        let z = Contact { n: V3::zeros(), r: 0.0, delta: 0.0, ri: 0.0, rj: 0.0, r_eff: 0.0, mi: 0.0, mj: 0.0, m_eff: 0.0, vr: V3::zeros(), vn: 0.0, wi: V3::zeros(), wj: V3::zeros(), dt: 0.0 };
+        let z = Contact {
+            n: V3::zeros(),
+            r: 0.0,
+            delta: 0.0,
+            ri: 0.0,
+            rj: 0.0,
+            r_eff: 0.0,
+            mi: 0.0,
+            mj: 0.0,
+            m_eff: 0.0,
+            vr: V3::zeros(),
+            vn: 0.0,
+            wi: V3::zeros(),
+            wj: V3::zeros(),
+            dt: 0.0,
+        };
         let p0 = self.table.get(1, self.wall_type);
         let mut b = Batch { q: [0; LANES], c: [z; LANES], pp: [p0; LANES], n: 0 };
         for q in qs {
@@ -371,9 +386,10 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
         let mut spec = PairSpec::new(cmd.span, true);
         // the model block ends at `primitive` or `mesh`
         let words = rest_after(a);
-        let end = words.iter().position(|w| w.text == "primitive" || w.text == "mesh").ok_or_else(|| {
-            Error::deck(a.end_span(), "fix wall/gran: missing `primitive type T <shape>` or `mesh n_meshes N meshes ...`")
-        })?;
+        let end = words
+            .iter()
+            .position(|w| w.text == "primitive" || w.text == "mesh")
+            .ok_or_else(|| Error::deck(a.end_span(), "fix wall/gran: missing `primitive type T <shape>` or `mesh n_meshes N meshes ...`"))?;
         let model_cmd = Command { words: std::iter::once(cmd.words[0].clone()).chain(words[..end].iter().cloned()).collect(), span: cmd.span };
         let mut ma = Args::new(&model_cmd);
         model::parse_liggghts_model(&mut ma, &mut spec)?;
@@ -470,7 +486,16 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
 
 /// Register a primitive wall fix running `spec`'s laws with `table`.
 #[allow(clippy::too_many_arguments)]
-fn add_wall(s: &mut Session, id: &str, group: u32, spec: PairSpec, table: ParamTable, wall_type: u32, wall: PrimitiveWall, motion: WallMotion) -> Result<()> {
+fn add_wall(
+    s: &mut Session,
+    id: &str,
+    group: u32,
+    spec: PairSpec,
+    table: ParamTable,
+    wall_type: u32,
+    wall: PrimitiveWall,
+    motion: WallMotion,
+) -> Result<()> {
     let kernel = model::build_kernel(&spec)?;
     let width = kernel.history_width();
     let summary = format!("wall/gran {} ({:?}): {}", id, wall, spec.summary());
@@ -492,7 +517,6 @@ fn add_wall(s: &mut Session, id: &str, group: u32, spec: PairSpec, table: ParamT
         candidates_at: None,
     }))
 }
-
 
 // ------------------------------------------------------------ LAMMPS granular walls
 
@@ -531,9 +555,10 @@ fn normal_arity(name: &str) -> Option<usize> {
 /// mu |F_ne| as for pairs); a sphere leaving a JKR wall turns into NaN in lmp.
 pub fn granular_coeffs(s: &mut Session, cmd: &Command, a: &mut Args, style: &Word) -> Result<(PairSpec, ParamTable)> {
     let rest = a.rest();
-    let end = rest.iter().position(|w| GRANULAR_WALL_STYLES.contains(&w.text.as_str())).ok_or_else(|| {
-        Error::deck(a.end_span(), "fix wall/gran granular: missing the wall style (xplane, yplane, zplane, zcylinder or region)")
-    })?;
+    let end = rest
+        .iter()
+        .position(|w| GRANULAR_WALL_STYLES.contains(&w.text.as_str()))
+        .ok_or_else(|| Error::deck(a.end_span(), "fix wall/gran granular: missing the wall style (xplane, yplane, zplane, zcylinder or region)"))?;
     let block = &rest[..end];
     // LAMMPS takes the sub-models in any order; the pair_coeff parser wants
     // the normal model first

@@ -136,9 +136,9 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
     }
     cfg.file_every = file_every.unwrap_or(cfg.every);
     let file = match file_name {
-        Some(w) if !s.check && !s.sim.dry => Some(
-            std::fs::File::create(&w.text).map_err(|e| Error::io(w.span, format!("cannot open '{}'", w.text), &e))?,
-        ),
+        Some(w) if !s.check && !s.sim.dry => {
+            Some(std::fs::File::create(&w.text).map_err(|e| Error::io(w.span, format!("cannot open '{}'", w.text), &e))?)
+        }
         _ => None,
     };
     if let Some(f) = &file {

@@ -130,15 +130,14 @@ const MATH: &[(&str, usize)] = &[
 ];
 
 /// Group functions answered by [`super::EvalContext::group_function`].
-const GROUP: &[&str] = &[
-    "count", "mass", "charge", "xcm", "vcm", "fcm", "bound", "gyration", "ke", "angmom", "torque", "inertia", "omega",
-];
+const GROUP: &[&str] = &["count", "mass", "charge", "xcm", "vcm", "fcm", "bound", "gyration", "ke", "angmom", "torque", "inertia", "omega"];
 
 /// Special functions that name things rather than compute numbers.
 const SPECIAL: &[&str] = &["is_defined", "is_active", "is_available"];
 
 /// Special functions LAMMPS has that demx does not evaluate.
-const UNSUPPORTED: &[&str] = &["sum", "min", "max", "ave", "trap", "slope", "gmask", "rmask", "grmask", "next", "is_file", "extract_setting", "label2type"];
+const UNSUPPORTED: &[&str] =
+    &["sum", "min", "max", "ave", "trap", "slope", "gmask", "rmask", "grmask", "next", "is_file", "extract_setting", "label2type"];
 
 /// Per-atom vectors usable as bare words in atom-style formulas.
 pub const ATOM_VECTORS: &[&str] = &["id", "mass", "type", "mol", "radius", "q", "x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz"];
@@ -172,10 +171,7 @@ fn number(i: &str) -> IResult<&str, &str> {
 }
 
 fn ident(i: &str) -> IResult<&str, &str> {
-    recognize(pair(
-        take_while1(|c: char| c.is_ascii_alphabetic() || c == '_'),
-        take_while(|c: char| c.is_ascii_alphanumeric() || c == '_'),
-    ))(i)
+    recognize(pair(take_while1(|c: char| c.is_ascii_alphabetic() || c == '_'), take_while(|c: char| c.is_ascii_alphanumeric() || c == '_')))(i)
 }
 
 fn index(i: &str) -> IResult<&str, &str> {
@@ -204,7 +200,8 @@ impl<'a> Parser<'a> {
     fn binop(&mut self) -> Option<BinOp> {
         self.skip_ws();
         let r = self.rest();
-        let two = [("<=", BinOp::Le), (">=", BinOp::Ge), ("==", BinOp::Eq), ("!=", BinOp::Ne), ("&&", BinOp::And), ("||", BinOp::Or), ("|^", BinOp::Xor)];
+        let two =
+            [("<=", BinOp::Le), (">=", BinOp::Ge), ("==", BinOp::Eq), ("!=", BinOp::Ne), ("&&", BinOp::And), ("||", BinOp::Or), ("|^", BinOp::Xor)];
         for (t, op) in two {
             if r.starts_with(t) {
                 return Some(op);

@@ -355,7 +355,12 @@ impl Interpreter {
                         "screen" => Echo::Screen,
                         "log" => Echo::Log,
                         "both" => Echo::Both,
-                        _ => return Err(Error::deck(w.span, format!("illegal echo command: unknown setting '{}' (expected none, screen, log, both)", w.text))),
+                        _ => {
+                            return Err(Error::deck(
+                                w.span,
+                                format!("illegal echo command: unknown setting '{}' (expected none, screen, log, both)", w.text),
+                            ))
+                        }
                     },
                     _ => return Err(Error::deck(name_span, "illegal echo command: expected one of none, screen, log, both")),
                 };
@@ -505,7 +510,12 @@ impl Interpreter {
                         screen = yes;
                     }
                 }
-                other => return Err(Error::deck(kw.text.span(), format!("illegal print command: unknown keyword '{other}' (expected file, append, screen, universe)"))),
+                other => {
+                    return Err(Error::deck(
+                        kw.text.span(),
+                        format!("illegal print command: unknown keyword '{other}' (expected file, append, screen, universe)"),
+                    ))
+                }
             }
             k += 2;
         }

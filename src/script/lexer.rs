@@ -221,10 +221,7 @@ pub enum Reference {
 
 /// Replace `$` references outside quotes. `resolve` gets each reference and
 /// the span of the reference text; its result is inserted unscanned.
-pub fn substitute(
-    t: &Text,
-    resolve: &mut dyn FnMut(&Reference, Span) -> Result<String>,
-) -> Result<(Text, bool)> {
+pub fn substitute(t: &Text, resolve: &mut dyn FnMut(&Reference, Span) -> Result<String>) -> Result<(Text, bool)> {
     let b = t.s.as_bytes();
     if !b.contains(&b'$') {
         return Ok((t.clone(), false));
@@ -263,9 +260,7 @@ pub fn substitute(
                 };
                 let inner = &t.s[i + 2..j];
                 let r = match inner.rfind(':') {
-                    Some(c) if inner[c + 1..].starts_with('%') => {
-                        Reference::Immediate(inner[..c].to_string(), Some(inner[c + 1..].to_string()))
-                    }
+                    Some(c) if inner[c + 1..].starts_with('%') => Reference::Immediate(inner[..c].to_string(), Some(inner[c + 1..].to_string())),
                     _ => Reference::Immediate(inner.to_string(), None),
                 };
                 (r, j + 1)

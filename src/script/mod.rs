@@ -11,11 +11,11 @@
 //! The host is also the [`EvalContext`] of expressions: thermo keywords,
 //! `c_ID`, `f_ID`, `x[5]`, group functions and per-atom vectors come from it.
 
-pub mod source;
-pub mod lexer;
 pub mod expr;
-pub mod vars;
 pub mod interp;
+pub mod lexer;
+pub mod source;
+pub mod vars;
 
 pub use interp::Interpreter;
 pub use source::{FileId, SourceMap, Span};

@@ -327,7 +327,10 @@ impl Variables {
                 return Err(Error::unsupported(style_w.span, format!("variable style '{s}'")));
             }
             s => {
-                let styles = ["delete", "index", "loop", "world", "universe", "uloop", "string", "getenv", "format", "equal", "atom", "internal", "python", "file", "atomfile", "vector", "timer"];
+                let styles = [
+                    "delete", "index", "loop", "world", "universe", "uloop", "string", "getenv", "format", "equal", "atom", "internal", "python",
+                    "file", "atomfile", "vector", "timer",
+                ];
                 let e = Error::deck(style_w.span, format!("unknown variable style '{s}'"));
                 return Err(match did_you_mean(s, styles) {
                     Some(h) => e.with_hint(format!("did you mean '{h}'?")),
@@ -370,11 +373,21 @@ impl Variables {
                     [n1, n2] if style == VarStyle::Loop => (parse_int(n1)?, parse_int(n2)?),
                     _ => {
                         let sp = r.get(2).or(r.first()).map_or(style_w.span, |w| w.span);
-                        return Err(Error::deck(sp, format!("illegal variable command: expected '{} N [pad]'{}", style.keyword(), if style == VarStyle::Loop { " or 'loop N1 N2 [pad]'" } else { "" })));
+                        return Err(Error::deck(
+                            sp,
+                            format!(
+                                "illegal variable command: expected '{} N [pad]'{}",
+                                style.keyword(),
+                                if style == VarStyle::Loop { " or 'loop N1 N2 [pad]'" } else { "" }
+                            ),
+                        ));
                     }
                 };
                 if last < first || last < 1 || first < 0 {
-                    return Err(Error::deck(style_w.span.to(rest.last().map_or(style_w.span, |w| w.span)), format!("illegal variable command: invalid loop range {first}..{last}")));
+                    return Err(Error::deck(
+                        style_w.span.to(rest.last().map_or(style_w.span, |w| w.span)),
+                        format!("illegal variable command: invalid loop range {first}..{last}"),
+                    ));
                 }
                 let pad = if pad { last.to_string().len() } else { 0 };
                 Data::Loop { first, last, which: 0, pad }
@@ -668,14 +681,19 @@ impl Variables {
                 }
                 Val::V(ctx.atom_vector(kw)?)
             }
-            Expr::Thermo(kw) => Val::S(ctx.thermo(kw).ok_or_else(|| format!("unknown keyword '{kw}' in variable formula (or a value the last step did not compute)"))?),
+            Expr::Thermo(kw) => Val::S(
+                ctx.thermo(kw).ok_or_else(|| format!("unknown keyword '{kw}' in variable formula (or a value the last step did not compute)"))?,
+            ),
         })
     }
 
     fn func(&self, name: &str, vals: Vec<Val>, ctx: &dyn EvalContext) -> std::result::Result<Val, String> {
         match name {
             "random" | "normal" => {
-                let scal: Vec<f64> = vals.iter().map(|v| if let Val::S(x) = v { Ok(*x) } else { Err(format!("{name}() needs scalar arguments")) }).collect::<std::result::Result<_, _>>()?;
+                let scal: Vec<f64> = vals
+                    .iter()
+                    .map(|v| if let Val::S(x) = v { Ok(*x) } else { Err(format!("{name}() needs scalar arguments")) })
+                    .collect::<std::result::Result<_, _>>()?;
                 let (a, b, seed) = (scal[0], scal[1], scal[2]);
                 let draw = |_: usize| -> std::result::Result<f64, String> {
                     if name == "random" {
@@ -727,7 +745,8 @@ pub fn resolve_reference(vars: &Variables, r: &super::lexer::Reference, span: Sp
             let x = vars.eval_expr(text, ctx).map_err(|m| Error::deck(span, m))?;
             match fmt {
                 None => Ok(cfmt::fmt_g(x, 20)),
-                Some(f) => cfmt::sprintf(f, &[cfmt::CArg::Float(x)]).map_err(|m| Error::deck(span, format!("invalid format '{f}' in immediate variable: {m}"))),
+                Some(f) => cfmt::sprintf(f, &[cfmt::CArg::Float(x)])
+                    .map_err(|m| Error::deck(span, format!("invalid format '{f}' in immediate variable: {m}"))),
             }
         }
     }

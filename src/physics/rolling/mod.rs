@@ -14,9 +14,9 @@ pub mod cdt;
 pub mod epsd;
 pub mod epsd2;
 pub mod epsd3;
-pub mod sds;
 pub mod marshall;
 pub mod paper;
+pub mod sds;
 
 use super::lanes::{Coeffs, Real, Vec3};
 use super::tangential::{get3_lanes, put3_lanes};

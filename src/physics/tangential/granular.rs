@@ -96,11 +96,7 @@ impl TangentialLaw for LammpsGranularHistory {
             xi *= a / hist[3];
         }
         let rsht = xi.dot(&c.n);
-        let frame_update = if m.force_history() {
-            rsht.abs() > EPSILON * f_scrit
-        } else {
-            rsht.abs() * k_t > EPSILON * f_scrit
-        };
+        let frame_update = if m.force_history() { rsht.abs() > EPSILON * f_scrit } else { rsht.abs() * k_t > EPSILON * f_scrit };
         if frame_update {
             let shrmag = xi.norm();
             xi -= c.n * rsht;
