@@ -4,6 +4,9 @@
 # behind DEMX_LONG=1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# formatting is part of the test (rustfmt.toml): a diff fails the run before
+# anything is built
+cargo fmt --check
 bash scripts/setup.sh
 # Open MPI (under both engines, even on one rank) creates its session
 # directory /tmp/ompi.<host>.<uid> at start when it is missing, and an
