@@ -410,7 +410,7 @@ fn grazing_pair(model: &str, props: &str) -> (Frames, Frames) {
         "atom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
 region reg block -0.01 0.01 -0.01 0.01 0 0.01 units box\ncreate_box 1 reg\nneighbor 0.0005 bin\nneigh_modify delay 0\n\
 fix m1 all property/global youngsModulus peratomtype 5.e6\nfix m2 all property/global poissonsRatio peratomtype 0.45\n\
-fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
 {props}pair_style gran {model}\npair_coeff * *\ntimestep 1e-6\n\
 fix floor all wall/gran {model} primitive type 1 zplane 0.0\n\
 create_atoms 1 single -0.002 0.0 0.0012 units box\ncreate_atoms 1 single 0.002 0.0006 0.0011 units box\n\
@@ -444,6 +444,7 @@ dump_modify d sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17
 /// the spin that `set ... omegaz` gives one of them).
 #[test]
 fn tangential_off_pushes_along_the_normal_only_as_liggghts() {
+    // no coefficientFriction: LIGGGHTS reads none for tangential off
     let (_, ours) = grazing_pair("model hertz tangential off", "");
     let (first, last) = (&ours[&0], ours.values().last().unwrap());
     for (step, rows) in &ours {
@@ -466,7 +467,8 @@ fn tangential_off_pushes_along_the_normal_only_as_liggghts() {
 /// spinning spheres' rolling torques as LIGGGHTS computes them.
 #[test]
 fn epsd3_reads_rolling_stiffness_as_liggghts() {
-    let props = "fix m5 all property/global coefficientRollingFriction peratomtypepair 1 0.3\n\
+    let props = "fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+fix m5 all property/global coefficientRollingFriction peratomtypepair 1 0.3\n\
 fix m6 all property/global coefficientRollingViscousDamping peratomtypepair 1 0.2\n\
 fix m7 all property/global rollingStiffness scalar 2.0\n";
     let (_, ours) = grazing_pair("model hertz tangential history rolling_friction epsd3", props);

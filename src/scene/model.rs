@@ -902,7 +902,11 @@ pub fn fill_table(s: &Session, spec: &PairSpec, span: Span) -> Result<ParamTable
                     ("coefficientRestitution", m.restitution.is_some()),
                 ]);
             }
-            needed.push(("coefficientFriction", m.friction.is_some()));
+            // `tangential off` reads no friction (LIGGGHTS 3.8 runs such a
+            // deck without coefficientFriction)
+            if spec.tangential != TangentialSpec::LigOff {
+                needed.push(("coefficientFriction", m.friction.is_some()));
+            }
             if matches!(spec.normal, NormalSpec::LigHooke { .. }) {
                 needed.push(("characteristicVelocity", m.char_vel.is_some()));
             }
