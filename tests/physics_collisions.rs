@@ -478,7 +478,8 @@ fix m7 all property/global rollingStiffness scalar 2.0\n";
 
 /// A LIGGGHTS deck without `thermo_style` prints LIGGGHTS's own columns
 /// (`Step Atoms KinEng CPU`), not LAMMPS's, and the same values (the CPU
-/// column is each program's clock); a LAMMPS deck keeps LAMMPS's.
+/// column is each program's clock); a LAMMPS deck keeps LAMMPS's; with a
+/// shrink-wrapped box both add `Volume`.
 #[test]
 fn default_thermo_columns_are_the_dialects() {
     let deck = "atom_style sphere\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
@@ -488,9 +489,20 @@ fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 
 pair_style gran model hertz tangential history\npair_coeff * *\ntimestep 1e-5\n\
 create_atoms 1 single 0.5 0.5 0.5\ncreate_atoms 1 single 0.2 0.5 0.5\nset group all diameter 0.1 density 2500\n\
 velocity all set 1 0 0\nfix 1 all nve/sphere\nfix g all gravity 9.81 vector 0 0 -1\nthermo 5\nrun 10\n";
+    let header = |out: &str| out.lines().find(|l| l.trim_start().starts_with("Step")).map(|l| l.split_whitespace().collect::<Vec<_>>().join(" "));
+    // a shrink-wrapped box adds the Volume column (both engines)
+    let shrunk = deck.replace("boundary f f f", "boundary m m m");
+    let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", &shrunk)]);
+    assert_eq!(header(&b.theirs_out).as_deref(), Some("Step Atoms KinEng CPU Volume"));
+    assert_eq!(header(&b.ours_out), header(&b.theirs_out));
+    let lammps = "units si\natom_style sphere\nboundary m m m\ncomm_modify vel yes\nregion reg block 0 1 0 1 0 1 units box\ncreate_box 1 reg\n\
+create_atoms 1 single 0.5 0.5 0.5\nset group all diameter 0.1 density 2500\npair_style gran/hooke 2e5 NULL 50 NULL 0.5 0\npair_coeff * *\n\
+velocity all set 1 0 0\nfix 1 all nve/sphere\nthermo 5\nrun 10\n";
+    let b = common::engine_and_demx("lmp", "in.deck", &[("in.deck", lammps)]);
+    assert_eq!(header(&b.theirs_out).as_deref(), Some("Step Temp E_pair E_mol TotEng Press Volume"));
+    assert_eq!(header(&b.ours_out), header(&b.theirs_out));
     let b = common::engine_and_demx("liggghts", "in.deck", &[("in.deck", deck)]);
     let (theirs, ours) = (common::thermo_runs(&b.theirs_out), common::thermo_runs(&b.ours_out));
-    let header = |out: &str| out.lines().find(|l| l.trim_start().starts_with("Step")).map(|l| l.split_whitespace().collect::<Vec<_>>().join(" "));
     assert_eq!(header(&b.theirs_out).as_deref(), Some("Step Atoms KinEng CPU"));
     assert_eq!(header(&b.ours_out), header(&b.theirs_out));
     assert_eq!(theirs[0].len(), 3, "{theirs:?}");

@@ -415,7 +415,17 @@ impl Session {
 
     fn run_command(&mut self, cmd: &Command, vars: &mut Variables) -> Result<()> {
         if self.sim.thermo.one {
-            self.sim.thermo.keywords = crate::engine::output::one_style(self.dialect_now());
+            let mut ks = crate::engine::output::one_style(self.dialect_now());
+            // both engines' thermo init: a style other than custom gains a
+            // Volume column when the box can change (shrink-wrapped sides;
+            // checked with lmp and liggghts on `boundary m m m`)
+            let shrinks = self.sim.domain.as_ref().is_some_and(|d| {
+                d.sides.iter().flatten().any(|s| matches!(s, crate::engine::domain::Side::Shrink | crate::engine::domain::Side::ShrinkMin))
+            });
+            if shrinks {
+                ks.push("vol".to_string());
+            }
+            self.sim.thermo.keywords = ks;
         }
         let mut a = Args::new(cmd);
         let n = a.i64("number of steps")?;

@@ -280,6 +280,9 @@ impl PairSpec {
 /// gran/* 2 x 2; LAMMPS granular 3 normal laws x 2 tangential x 5
 /// rolling/twisting), none that no deck can express.
 pub fn build_kernel(spec: &PairSpec) -> Result<Box<dyn ContactKernel>> {
+    if spec.tangential == TangentialSpec::LigOff && (spec.cohesion != CohesionSpec::Off || spec.rolling != RollingSpec::Off) {
+        return Err(Error::unsupported(spec.span, "tangential off with cohesion or rolling friction"));
+    }
     let k = match spec.normal {
         NormalSpec::LigHooke { kt_to_kn } => lig_tangential(normal::hooke::LiggghtsHooke { kt_to_kn }, spec),
         NormalSpec::LigHookeStiffness { absolute } => {
@@ -299,7 +302,9 @@ pub fn build_kernel(spec: &PairSpec) -> Result<Box<dyn ContactKernel>> {
 
 fn lig_tangential<N: NormalLaw + Send + 'static>(n: N, spec: &PairSpec) -> Option<Box<dyn ContactKernel>> {
     match spec.tangential {
-        TangentialSpec::LigOff => lig_cohesion(n, tangential::off::LiggghtsOff, spec),
+        // frictionless grains: one kernel per normal law, not one per
+        // cohesion and rolling law as well (each is compiled; see build_kernel)
+        TangentialSpec::LigOff => Some(finish(n, tangential::off::LiggghtsOff, NoCohesion, NoRolling)),
         TangentialSpec::LigNoHistory => lig_cohesion(n, tangential::no_history::LiggghtsNoHistory, spec),
         TangentialSpec::LigHistory => lig_cohesion(n, tangential::history::LiggghtsHistory, spec),
         TangentialSpec::PaperHistory => lig_cohesion(n, tangential::paper::PaperCundallStrack, spec),
