@@ -42,4 +42,13 @@ exit \$rc
 WRAP
     chmod +x "$wrap/$e"
 done
-PATH="$wrap:$PATH" cargo test --no-fail-fast "$@"
+# The library compiles twice (for the integration tests and for its unit
+# tests), each rustc peaking near 12 GB at opt-level 1 (every contact-law
+# combination is its own kernel): on a machine under 32 GB two at once were
+# killed for memory (2026-12-07, 24 GB), so there they go one at a time.
+jobs=()
+mem_kb=$(awk '/^MemTotal:/ {print $2}' /proc/meminfo 2>/dev/null || echo 0)
+if [ "${mem_kb:-0}" -lt 33554432 ]; then
+    jobs=(-j 1)
+fi
+PATH="$wrap:$PATH" cargo test "${jobs[@]}" --no-fail-fast "$@"
