@@ -331,8 +331,7 @@ fn last_gap(frames: &[Frame]) -> (f64, f64) {
 /// Runs both engines; returns (max relative difference, lmp frames).
 fn compare(c: &Case) -> Option<(f64, Vec<Frame>)> {
     if !have_lmp() {
-        eprintln!("skipped {}: 'lmp' is not on PATH", c.name);
-        return None;
+        panic!("{}: 'lmp' is not on PATH (bash scripts/setup.sh installs it)", c.name);
     }
     let dir = tempfile::tempdir().unwrap();
     let lmp_dir = dir.path().join("lmp");

@@ -4,8 +4,8 @@
 //! Engine agreement: small decks (1-3 spheres dropping onto, sliding along
 //! and spinning against a zplane, a zcylinder and a region block) run by the
 //! real `lmp` and by demx from the same deck text; every dumped position,
-//! velocity and spin compared over thousands of steps (skipped with a notice
-//! when `lmp` is not installed). Analytic: the restitution of a Tsuji-damped
+//! velocity and spin compared over thousands of steps (failing when `lmp`,
+//! which scripts/setup.sh installs, is missing). Analytic: the restitution of a Tsuji-damped
 //! Hertz wall impact equals the deck's e.
 //!
 //! Facts these decks pin down (measured with lmp, a sphere pressed into a
@@ -143,8 +143,7 @@ fn max_rel_diff(a: &[Frame], b: &[Frame]) -> f64 {
 /// Run both engines; returns (max relative difference, lmp frames).
 fn compare(name: &str, spheres: &[[f64; 11]], coeff: &str, wall: &str, steps: u32, gravity: bool) -> Option<(f64, Vec<Frame>)> {
     if !have_lmp() {
-        eprintln!("skipped {name}: 'lmp' is not on PATH");
-        return None;
+        panic!("{name}: 'lmp' is not on PATH (bash scripts/setup.sh installs it)");
     }
     let dir = tempfile::tempdir().unwrap();
     let mut frames = vec![];
