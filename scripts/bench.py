@@ -26,6 +26,8 @@ The bed is made by bench/in.bed_prepare.liggghts (7,500 spheres settled in a
 """
 import argparse, datetime, os, re, shutil, statistics, subprocess, sys
 
+from mdblock import replace_block
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEMX = os.path.join(ROOT, "target", "release", "demx")
 WORK = os.path.join(ROOT, "target", "bench")
@@ -371,15 +373,7 @@ def write(a, rows, scaling):
                           f"({lo['n']:,}, {lo['demx']:.3e}) is {100 * (1 - lo['demx'] / hi['demx']):.0f}% below the fastest "
                           f"({hi['n']:,}, {hi['demx']:.3e})."]
     lines += ["", PROFILE_END]
-    block = "\n".join(lines)
-    old = open(a.out).read() if os.path.exists(a.out) else "# Benchmarks\n"
-    if PROFILE_BEGIN in old:
-        new = re.sub(re.escape(PROFILE_BEGIN) + r".*?" + re.escape(PROFILE_END), lambda _: block, old, flags=re.S)
-    else:
-        new = old.rstrip() + "\n\n" + block + "\n"
-    with open(a.out + ".tmp", "w") as f:
-        f.write(new)
-    os.replace(a.out + ".tmp", a.out)
+    replace_block(a.out, PROFILE_BEGIN, PROFILE_END, "\n".join(lines), "# Benchmarks")
     print("wrote", a.out)
 
 

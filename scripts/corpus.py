@@ -10,6 +10,8 @@ Usage: python3 scripts/corpus.py [--demx target/release/demx] [--only SUBSTR]
 """
 import argparse, csv, os, re, shutil, subprocess, sys, tempfile, time
 
+from mdblock import replace_block
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CORPUS = os.environ.get("DEMX_SHARED", os.path.join(os.path.dirname(ROOT), "shared")) + "/decks-run"
 BEGIN, END = "<!-- corpus:begin (scripts/corpus.py) -->", "<!-- corpus:end -->"
@@ -112,16 +114,8 @@ def main():
     esc = lambda x: str(x).replace("|", "\\|")
     lines += [f"| {' | '.join(esc(c) for c in row)} |" for row in rows]
     lines += ["", END]
-    block = "\n".join(lines)
     if not a.only:
-        old = open(a.out).read() if os.path.exists(a.out) else "# Deck compatibility\n"
-        if BEGIN in old:
-            new = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: block, old, flags=re.S)
-        else:
-            new = old.rstrip() + "\n\n" + block + "\n"
-        with open(a.out + ".tmp", "w") as f:
-            f.write(new)
-        os.replace(a.out + ".tmp", a.out)
+        replace_block(a.out, BEGIN, END, "\n".join(lines), "# Deck compatibility")
         print("wrote", a.out)
     print(f"{n} decks: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
 
