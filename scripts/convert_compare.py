@@ -181,7 +181,7 @@ def main():
         "(create_atoms random + delete_atoms overlap: the same count, other positions), insert/pack every E a fix pour of "
         "N x the insertions (pour's own interval and fall speeds). Normal forces are identical: tsuji damping with e' solved "
         "to match LIGGGHTS' damping, and wall lines with E/(1+nu) because LAMMPS' wall/gran granular takes the wall modulus "
-        "as E/(2(1-nu)) (tests/convert_insert.rs drops a sphere on both walls: 1e-9 m agreement).\n"
+        "as E/(2(1-nu)) (tests/it/convert_insert.rs drops a sphere on both walls: 1e-9 m agreement).\n"
     )
     verdicts = []
     if not a.skip_heap:

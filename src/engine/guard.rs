@@ -36,7 +36,7 @@ use std::io::Write;
 
 /// Default overlap limit, fraction of the (smaller) radius. Measured: the
 /// LIGGGHTS packing tutorial (particles grown by fix adapt, Y = 5 MPa) ends
-/// with 33 %, its 125x faster-growing test variant (tests/tutorials_run.rs)
+/// with 33 %, its 125x faster-growing test variant (tests/it/tutorials_run.rs)
 /// peaks at 60 %; resolved collisions stay far below. At 75 % a quarter of the
 /// smaller sphere is inside the other: placements that close are stopped.
 pub const DEFAULT_OVERLAP: f64 = 0.75;
@@ -217,7 +217,7 @@ fn note_setup_overlaps(sim: &mut Sim) {
             found.push((ta, tb, f));
         }
     }
-    found.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+    found.sort_by_key(|x| (x.0, x.1));
     sim.guard.setup_overlaps = found;
 }
 
@@ -286,13 +286,13 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
             let r2 = p.radius[i] * p.radius[i];
             if r2 > 0.0 && v2 * dt2 > t2 * r2 {
                 let ratio = (v2 * dt2 / r2).sqrt();
-                if worst_travel.map_or(true, |(_, w)| ratio > w) {
+                if worst_travel.is_none_or(|(_, w)| ratio > w) {
                     worst_travel = Some((i, ratio));
                 }
             }
         }
         if let Some(s2) = speed2 {
-            if v2 > s2 && worst_speed.map_or(true, |(_, w)| v2 > w * w) {
+            if v2 > s2 && worst_speed.is_none_or(|(_, w)| v2 > w * w) {
                 worst_speed = Some((i, v2.sqrt()));
             }
         }
@@ -316,7 +316,7 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
                 let r2 = (p.x[a] - p.x[b] - pl.shift(k)).norm_squared();
                 if reach > 0.0 && r2 < reach * reach {
                     let f = pair_overlap(p, pl, k);
-                    if worst.map_or(true, |(_, _, w)| f > w) {
+                    if worst.is_none_or(|(_, _, w)| f > w) {
                         worst = Some((a, b, f));
                     }
                 }
@@ -325,7 +325,7 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
         };
         let mut worst: Option<(usize, usize, f64)> = None;
         for (a, b, f) in in_chunks(pl.len(), GUARD_CHUNK, deepest).into_iter().flatten() {
-            if worst.map_or(true, |(_, _, w)| f > w) {
+            if worst.is_none_or(|(_, _, w)| f > w) {
                 worst = Some((a, b, f));
             }
         }
@@ -335,7 +335,7 @@ fn find_trip(sim: &Sim, overlaps: bool) -> Option<Trip> {
         let mut worst_wall: Option<(usize, usize, f64)> = None;
         for (k, fix) in sim.fixes.iter().enumerate() {
             if let Some((i, f)) = fix.max_surface_overlap(sim) {
-                if f > lim && i < n && worst_wall.map_or(true, |(_, _, w)| f > w) {
+                if f > lim && i < n && worst_wall.is_none_or(|(_, _, w)| f > w) {
                     worst_wall = Some((i, k, f));
                 }
             }
@@ -532,7 +532,7 @@ fn fail(sim: &mut Sim, trip: Trip, at_setup: bool) -> Error {
     }
     let ts_text =
         g.timestep.map(|t| format!("timestep {} is {} of the Hertz time and {} of the Rayleigh time", g4(sim.dt), pct(t.hertz), pct(t.rayleigh)));
-    let ts_big = g.timestep.map_or(false, |t| t.hertz.max(t.rayleigh) > TIMESTEP_SUSPECT_FRACTION);
+    let ts_big = g.timestep.is_some_and(|t| t.hertz.max(t.rayleigh) > TIMESTEP_SUSPECT_FRACTION);
     if ts_big {
         causes.push(format!(
             "timestep too large for the stiffness: {} (keep both below {})",

@@ -130,7 +130,7 @@ impl Fix for HeatGran {
     /// The step's fluxes start from zero (sources stay): every grain's,
     /// in the group or not, as Debian's LIGGGHTS 3.8 runs it (a grain
     /// outside the group shows one step's flux, not a running sum;
-    /// tests/heat_gran.rs).
+    /// tests/it/heat_gran.rs).
     fn initial_integrate(&mut self, sim: &mut Sim) {
         let [_, fc, _, dc] = self.columns(sim);
         let p = &mut sim.particles;

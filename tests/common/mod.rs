@@ -1,5 +1,5 @@
-//! Helpers for the tests that run a real engine (`lmp`, `liggghts`) and demx
-//! on the same deck: each such test file says `mod common;`.
+//! Helpers shared by the integration tests (`tests/it`), e.g. for running a real engine (`lmp`, `liggghts`) and demx
+//! on the same deck: a test file says `use crate::common;`.
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
@@ -52,7 +52,7 @@ pub fn dump_frames(path: &Path) -> BTreeMap<i64, BTreeMap<i64, Vec<f64>>> {
             step = lines.next().unwrap().trim().parse().unwrap();
         } else if l.starts_with("ITEM: ATOMS") {
             let rows: &mut BTreeMap<i64, Vec<f64>> = out.entry(step).or_default();
-            while lines.peek().map_or(false, |l| !l.starts_with("ITEM")) {
+            while lines.peek().is_some_and(|l| !l.starts_with("ITEM")) {
                 let v: Vec<f64> = lines.next().unwrap().split_whitespace().map(|w| w.parse().unwrap()).collect();
                 rows.insert(v[0] as i64, v[1..].to_vec());
             }

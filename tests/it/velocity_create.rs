@@ -5,7 +5,7 @@
 //! decks also `set diameter` after `set density`, which keeps the mass in
 //! LAMMPS (not in LIGGGHTS), so the mass column checks that too.
 
-mod common;
+use crate::common;
 
 /// 480 spheres on an fcc lattice, two types of different size and density.
 const LJ: &str = "units lj\natom_style sphere\nboundary p p f\ncomm_modify vel yes\nlattice fcc 1.0\n\

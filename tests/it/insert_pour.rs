@@ -23,7 +23,7 @@ fn changes(thermo: &str) -> Vec<(i64, usize)> {
         }
         if on && w.len() == 2 {
             if let (Ok(s), Ok(n)) = (w[0].parse::<i64>(), w[1].parse::<usize>()) {
-                if out.last().map_or(true, |l| l.1 != n) {
+                if out.last().is_none_or(|l| l.1 != n) {
                     out.push((s, n));
                 }
             }

@@ -396,7 +396,7 @@ fn lammps_tsuji_restitution_matches_lmp() {
     }
 }
 
-mod common;
+use crate::common;
 
 type Frames = std::collections::BTreeMap<i64, std::collections::BTreeMap<i64, Vec<f64>>>;
 

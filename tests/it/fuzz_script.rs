@@ -243,7 +243,16 @@ fn fuzz_interpreter_never_panics() {
     let mut rng = XorShift(seed | 1);
     let t0 = std::time::Instant::now();
     let mut errors = 0usize;
-    std::panic::set_hook(Box::new(|_| {}));
+    // the expected panics of this thread stay quiet; the other tests of the
+    // binary (threads of the same process) keep their panic messages
+    thread_local!(static QUIET: std::cell::Cell<bool> = const { std::cell::Cell::new(false) });
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !QUIET.with(std::cell::Cell::get) {
+            default(info)
+        }
+    }));
+    QUIET.with(|q| q.set(true));
     for case in 0..cases {
         let base = &seeds[rng.below(seeds.len())];
         let deck = mutate(&mut rng, &seeds, base);
@@ -258,14 +267,14 @@ fn fuzz_interpreter_never_panics() {
         match r {
             Ok(is_err) => errors += usize::from(is_err),
             Err(_) => {
-                let _ = std::panic::take_hook();
+                QUIET.with(|q| q.set(false));
                 let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz-panic.in");
                 let _ = std::fs::write(&path, &deck);
                 panic!("case {case} (seed {seed}) panicked; deck saved to {}", path.display());
             }
         }
     }
-    let _ = std::panic::take_hook();
+    QUIET.with(|q| q.set(false));
     eprintln!("{cases} cases ({errors} errors) from {} seeds in {:.1?}", seeds.len(), t0.elapsed());
     assert!(errors < cases || cases == 0, "every mutated deck failed: mutations too destructive");
 }

@@ -2,7 +2,7 @@
 //! polydata with per-triangle stresses, velocities and topology, in the
 //! three `output` modes, against `liggghts` on the same deck.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -163,11 +163,10 @@ fn linearly_moving_floor_carries_a_resting_sphere() {
 #[test]
 fn rotating_mesh_moves_its_contacts_and_dump_mesh_stl_writes_the_moved_mesh() {
     let tmp = tempfile::tempdir().expect("tempdir");
-    let deck = format!(
-        "include ${{DIR}}/in.base\nfix cad all mesh/surface file ${{DIR}}/floor.stl type 1\n\
+    let deck = "include ${DIR}/in.base\nfix cad all mesh/surface file ${DIR}/floor.stl type 1\n\
          fix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
          fix mv all move/mesh mesh cad rotate origin 0 0 0 axis 0 0 1 period 0.4\nrun 100\n"
-    );
+        .to_string();
     let (mut s, _) = run_deck(&deck, &[("E", "0.7"), ("X", "0.02"), ("Y", "0"), ("Z", "0.0049"), ("VX", "0"), ("VZ", "0")]);
     // a dump added through the library entry point outputs.rs routes to
     let path = format!("{}/m*.stl", tmp.path().display());
@@ -176,8 +175,8 @@ fn rotating_mesh_moves_its_contacts_and_dump_mesh_stl_writes_the_moved_mesh() {
     let cmd = demx::script::Command { words, span };
     let d = demx::scene::mesh::dump_mesh_stl(&s, &cmd).expect("dump");
     s.sim.dumps.push(Box::new(d));
-    let mut vars = demx::script::Variables::new();
-    s.sim.run(100, &mut vars, true, false).expect("run");
+    let vars = demx::script::Variables::new();
+    s.sim.run(100, &vars, true, false).expect("run");
     // after 200 steps (2e-3 s) the square turned by 2 pi * 2e-3 / 0.4 rad about z
     let text = std::fs::read_to_string(tmp.path().join("m200.stl")).expect("dump file");
     let th = 2.0 * std::f64::consts::PI * 2e-3 / 0.4;
@@ -307,7 +306,7 @@ fn meshgran_tutorial_walls_run() {
     );
     let (s, _) = run_deck(&deck, &[]);
     let p = &s.sim.particles;
-    assert!(p.len() > 0);
+    assert!(!p.is_empty());
     // the CAD walls hold the spheres inside the box region
     for i in 0..p.len() {
         assert!(p.x[i].iter().all(|c| c.is_finite()));

@@ -84,7 +84,7 @@ fn thin_layer_on_the_sheet_is_blown_and_measured() {
     let h = &j["hops"];
     assert!(h["samples_up"].as_u64().unwrap() + h["samples_down"].as_u64().unwrap() > 0, "{out}");
     for k in ["q_mean", "zb", "delta_s_dm"] {
-        assert!(j[k].as_f64().map_or(false, f64::is_finite), "{k} not finite: {out}");
+        assert!(j[k].as_f64().is_some_and(f64::is_finite), "{k} not finite: {out}");
     }
     assert!(std::fs::metadata(d.join("s.png")).unwrap().len() > 1000);
 }

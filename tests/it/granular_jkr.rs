@@ -60,7 +60,7 @@ fn dmt_force_matches_lmp_and_formula() {
     let mut out = ContactOut::default();
     LammpsDmt { damping: GranularDamping::Viscoelastic }.normal(&c, &params(0.0), &mut [], &mut out);
     // printed by lmp: pair_coeff * * dmt 1e7 0 0.3 0.1, R = 1 mm, delta = 10 um
-    assert!(rel(out.fn_total(), 4.5519509285241681e-3) < 1e-14, "{}", out.fn_total());
+    assert!(rel(out.fn_total(), 4.551_950_928_524_168e-3) < 1e-14, "{}", out.fn_total());
     // Hertz minus 4 pi gamma R*
     let hertz = 4.0 / 3.0 * e_eff() * (R_EFF * 1e-5).sqrt() * 1e-5;
     assert!(rel(out.fn_total(), hertz - 4.0 * PI * GAMMA * R_EFF) < 1e-14);
@@ -109,7 +109,7 @@ fn jkr_force_matches_lmp() {
     let mut h = [0.0];
     LammpsJkr { damping: GranularDamping::Viscoelastic }.normal(&c, &params(0.0), &mut h, &mut out);
     // printed by lmp: pair_coeff * * jkr 1e7 0 0.3 0.1, R = 1 mm, delta = 10 um
-    assert!(rel(out.fn_total(), 4.8479169452017579e-3) < 1e-13, "{}", out.fn_total());
+    assert!(rel(out.fn_total(), 4.847_916_945_201_758e-3) < 1e-13, "{}", out.fn_total());
     assert_eq!(h[0], 1.0, "touched flag set");
     // cap: F_ne + 6 pi gamma R*
     assert!(rel(out.fn_for_friction, out.fn_elastic + 6.0 * PI * GAMMA * R_EFF) < 1e-14);

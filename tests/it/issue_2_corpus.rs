@@ -42,7 +42,7 @@ fn corpus() -> Vec<PathBuf> {
 }
 
 fn is_deck(p: &Path) -> bool {
-    p.is_file() && p.file_name().and_then(|n| n.to_str()).map_or(false, |n| n.starts_with("in."))
+    p.is_file() && p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("in."))
 }
 
 fn check(deck: &Path, extra: &[&str]) -> (i32, String) {

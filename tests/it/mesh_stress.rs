@@ -1,7 +1,7 @@
 //! `fix mesh/surface/stress` (LIGGGHTS 3.8): the force and torque the
 //! grains put on a mesh, `f_ID[1..9]`, against `liggghts` on the same deck.
 
-mod common;
+use crate::common;
 
 /// The plate at z = 0.
 fn plate() -> String {

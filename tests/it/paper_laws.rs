@@ -213,7 +213,7 @@ fn vdw_force_in_contact_midway_and_beyond_cutoff() {
     let mut out = ContactOut::default();
     Hamaker::default().cohesion(&wall(1e-7, V3::zeros(), V3::zeros(), 1e-8), &p, &mut [], &mut out);
     assert_eq!(out.fn_coh, 0.0);
-    assert!(<Hamaker as CohesionLaw>::NONCONTACT);
+    const { assert!(<Hamaker as CohesionLaw>::NONCONTACT) };
 }
 
 /// The caps with van der Waals: Eq. 11's mu |F^c_n| and Eq. 15's mu_r R* |F^c_n|

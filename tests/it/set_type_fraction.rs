@@ -3,7 +3,7 @@
 //! one-at-a-time hash, `RanPark::reset`), so the types are the same as
 //! lmp's atom by atom, not only in proportion.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::Path;

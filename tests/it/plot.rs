@@ -70,7 +70,7 @@ fn two_panels_give_a_png_of_two_panel_widths_with_the_series_drawn() {
         series: vec![sq],
         ..Chart::default()
     };
-    let decay: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, 10f64.powi(-(i as i32) / 5))).collect();
+    let decay: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, 10f64.powi(-i / 5))).collect();
     let err = decay.iter().map(|p| 0.3 * p.1).collect();
     let log = Chart {
         title: "decay".into(),

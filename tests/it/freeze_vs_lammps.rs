@@ -9,7 +9,7 @@
 //! were NaN. Both, printed every 50 steps by `fix print`, must now follow
 //! LAMMPS's.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -6,7 +6,7 @@
 //! lets them fall and fly (one through a periodic side), and dumps
 //! `c_d[1..4]` every 1500 steps; demx's dumps must agree atom by atom.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 

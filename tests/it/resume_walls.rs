@@ -14,7 +14,7 @@ use demx::io::dump::{DumpReader, Frame};
 use std::path::Path;
 use std::process::Command;
 
-mod common;
+use crate::common;
 
 /// The restart step, the dump interval (frames at R + 1 and 2 R + 2 after
 /// it) and the last step.
@@ -97,11 +97,11 @@ fix wall all wall/gran model hertz tangential history rolling_friction epsd mesh
 fix floor all wall/gran model hertz tangential history rolling_friction epsd primitive type 1 zplane 0.0\n\
 fix g all gravity 9.81 vector 0.05 0.02 -1\nfix 1 all nve/sphere\ntimestep 2e-6\n";
     let head = format!("{setup}{head_box}{model}velocity all set 0.01 0.005 0\n");
-    let resume_head = format!("{setup}");
+    let resume_head = setup.to_string();
     // the plate covers x, y in [0, 0.004] at z = 0.002: half the grains land on it, half on the floor
     let files = [("plate.stl", common::plate_stl("0.002"))];
     let files: Vec<(&str, &str)> = files.iter().map(|(n, t)| (*n, t.as_str())).collect();
-    let (full, resumed) = full_and_resumed(&files, &head, &format!("{resume_head}"), tail);
+    let (full, resumed) = full_and_resumed(&files, &head, &resume_head.to_string(), tail);
     let (on_floor, turning) = assert_bitwise(&full, &resumed, 0.0, 0.00045);
     // the scene is the one meant: grains rest on both walls and turn
     let last = full.iter().find(|f| f.timestep == END).unwrap();

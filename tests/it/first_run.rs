@@ -22,7 +22,7 @@ fn run_in(dir: &Path, args: &[&str]) -> (bool, String) {
     (o.status.success(), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
 }
 
-/// A 2 mm sphere on a floor held by `cohesion sjkr` (tests/cohesion_caps.rs),
+/// A 2 mm sphere on a floor held by `cohesion sjkr` (tests/it/cohesion_caps.rs),
 /// with the LIGGGHTS tutorials' Y = 1e7 Pa.
 const SJKR_DECK: &str = "atom_style granular
 atom_modify map array

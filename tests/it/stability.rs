@@ -32,7 +32,7 @@ use std::time::Instant;
 
 /// Whether the long versions were asked for.
 fn long() -> bool {
-    std::env::var("DEMX_LONG").map_or(false, |v| v == "1")
+    std::env::var("DEMX_LONG").is_ok_and(|v| v == "1")
 }
 
 /// `fast` steps in the default run, `full` with DEMX_LONG=1.

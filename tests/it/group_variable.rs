@@ -1,7 +1,7 @@
 //! `group ID variable NAME` (LAMMPS): the atoms whose atom-style variable is
 //! non-zero, against `lmp` on the same deck.
 
-mod common;
+use crate::common;
 
 /// A 6 x 6 x 6 lattice, a group by a variable mixing coordinates, types
 /// and ids, and what LAMMPS prints of it.

@@ -2,7 +2,7 @@
 //! away (exit 2 with the file, line and what is wrong), and analysis tools
 //! that must not print a wrong answer.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

@@ -3,7 +3,7 @@
 //! the energy balance of heat sources, and against `liggghts` on a moving
 //! bed of two materials with adiabatic grains.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

@@ -6,10 +6,11 @@
 //!   set up with no atoms, prints `-0` throughout.
 //! - in.granregion.funnel: `region ID delete` of the regions a wall uses, which
 //!   are defined again and the wall fixed again before the next run.
+//!
 //! The thermo rows of every run must agree: exactly while nothing touches, to
 //! 1e-5 relative once the grains pile up (rounding grows in a heap).
 
-mod common;
+use crate::common;
 
 const EXAMPLES: &str = "/usr/share/lammps/examples/granregion";
 

@@ -2,7 +2,7 @@
 //! `demx run` and their dumps compared with closed forms (free fall, LIGGGHTS
 //! Hertz restitution, Hertz contact duration, elastic energy and momentum,
 //! slip onset of a sphere on an incline). Complements the law-level checks in
-//! tests/physics_collisions.rs.
+//! tests/it/physics_collisions.rs.
 
 use demx::io::dump::{DumpReader, Frame};
 use std::f64::consts::PI;

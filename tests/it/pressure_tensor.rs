@@ -7,9 +7,9 @@
 //! compressed periodic lattice with tangential history, and in 2d on
 //! LAMMPS's granular chute example.
 
-mod common;
+use crate::common;
 
-use common::{engine_and_demx, thermo_runs};
+use crate::common::{engine_and_demx, thermo_runs};
 
 /// 216 spheres of diameter 1.05 on a simple cubic lattice of spacing 1, in a
 /// periodic box: every neighbour pair overlaps, and random velocities shear

@@ -27,7 +27,7 @@ fn reads_lammps_and_liggghts_data() {
     // LIGGGHTS: "4.0000000000000001e-03 2.5000000000000000e+03" and omega of atom 3 "7.1246040602584202e+01"
     let a3 = l.atoms.iter().find(|a| a.id == 3).unwrap();
     assert_eq!((a3.diameter, a3.density), (0.004, 2500.0));
-    assert_eq!(a3.omega[0], 7.1246040602584202e+01);
+    assert_eq!(a3.omega[0], 7.124_604_060_258_42e1);
 }
 
 #[test]
