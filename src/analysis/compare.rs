@@ -238,7 +238,7 @@ pub fn load(spec: &str) -> Result<Vec<Series>> {
         let mut files: Vec<PathBuf> = rd
             .flatten()
             .map(|e| e.path())
-            .filter(|f| f.is_file() && f.file_name().map_or(false, |n| glob_match(&pat, &n.to_string_lossy().chars().collect::<Vec<_>>())))
+            .filter(|f| f.is_file() && f.file_name().is_some_and(|n| glob_match(&pat, &n.to_string_lossy().chars().collect::<Vec<_>>())))
             .collect();
         files.sort();
         if files.is_empty() {
@@ -578,11 +578,11 @@ pub fn compare_series(a: &Series, b: &Series, o: &CompareOptions) -> Comparison 
         }
     }
     let mut notes: Vec<String> = a.notes.iter().chain(&b.notes).cloned().collect();
-    let no_mass = a.snaps.first().map_or(false, |s| s.m.is_none()) && o.density.is_none();
+    let no_mass = a.snaps.first().is_some_and(|s| s.m.is_none()) && o.density.is_none();
     if no_mass {
         notes.push("no mass column and no --density: kinetic energies are per unit density (kg/m^3)".into());
     }
-    if a.snaps.first().map_or(false, |s| s.r.is_none()) && b.snaps.first().map_or(false, |s| s.r.is_none()) {
+    if a.snaps.first().is_some_and(|s| s.r.is_none()) && b.snaps.first().is_some_and(|s| s.r.is_none()) {
         notes.push(format!(
             "no radius column: deviations in units of {}",
             o.diameter.map_or("length (use --diameter)".to_string(), |d| format!("d = {d}"))
@@ -658,7 +658,7 @@ pub fn render(c: &Comparison) -> String {
     let n = c.frames.len();
     let step = (n / 40).max(1);
     for (k, f) in c.frames.iter().enumerate() {
-        let special = c.divergence.map_or(false, |d| d.0 == f.timestep) || f.timestep == c.worst.1;
+        let special = c.divergence.is_some_and(|d| d.0 == f.timestep) || f.timestep == c.worst.1;
         if k % step != 0 && k + 1 != n && !special {
             continue;
         }

@@ -449,10 +449,10 @@ fn dump_frames(dir: &Path, installed: &[PathBuf], pattern: Option<&str>) -> Resu
     for f in &files {
         for fr in DumpReader::open(f)? {
             let fr = fr?;
-            if first.as_ref().map_or(true, |a| fr.timestep < a.timestep) {
+            if first.as_ref().is_none_or(|a| fr.timestep < a.timestep) {
                 first = Some(fr.clone());
             }
-            if last.as_ref().map_or(true, |a| fr.timestep >= a.timestep) {
+            if last.as_ref().is_none_or(|a| fr.timestep >= a.timestep) {
                 last = Some(fr);
             }
         }

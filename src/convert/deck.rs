@@ -69,11 +69,10 @@ pub fn split_words(s: &str) -> Vec<String> {
 pub fn logical_lines(src: &str) -> Vec<Logical> {
     let mut out = Vec::new();
     let mut offset = 0usize;
-    let mut lineno = 0usize;
     let mut pending: Option<Logical> = None;
     let mut joined = String::new();
-    for raw in src.split_inclusive('\n') {
-        lineno += 1;
+    for (k, raw) in src.split_inclusive('\n').enumerate() {
+        let lineno = k + 1;
         let start = offset;
         offset += raw.len();
         let (body, eol) = if let Some(b) = raw.strip_suffix("\r\n") {
@@ -230,10 +229,8 @@ impl Facts {
                     "property/global" if w.len() >= 6 => {
                         let style = w[5].clone();
                         let mut values = w[6..].to_vec();
-                        if style.contains("pair") || style == "peratomtype" {
-                            if style.contains("pair") && !values.is_empty() {
-                                values.remove(0);
-                            }
+                        if (style.contains("pair") || style == "peratomtype") && style.contains("pair") && !values.is_empty() {
+                            values.remove(0);
                         }
                         f.props.insert(w[4].clone(), Property { id: w[1].clone(), style, values });
                     }

@@ -10,6 +10,7 @@
 //!   2 sqrt(5/6) |beta(e)| sqrt(2 Y* a m*): equal when alpha(e') =
 //!   sqrt(5) |beta(e)|, so e' is solved from that (possible for e >= ~0.114);
 //! - tangential damping ratio xgt = gamma_t/gamma_n = 2 sqrt(G*/Y*).
+//!
 //! The normal force law is then identical; what remains different is the
 //! tangential model (LAMMPS caps the total tangential force including
 //! damping and rescales history; LIGGGHTS caps the elastic part, no damping
@@ -925,12 +926,9 @@ pub fn split_run(ctx: &mut Ctx, w: &[String]) -> Option<Action> {
     let end = run_end(ctx.facts, w, start)?;
     let mut out = Vec::new();
     let mut cur = start;
-    loop {
-        // the earliest pending insertion inside (cur, end]
-        let Some(k) = (0..ctx.insert_schedules.len()).filter(|&k| ctx.insert_schedules[k].next <= end).min_by_key(|&k| ctx.insert_schedules[k].next)
-        else {
-            break;
-        };
+    // the earliest pending insertion inside (cur, end]
+    while let Some(k) = (0..ctx.insert_schedules.len()).filter(|&k| ctx.insert_schedules[k].next <= end).min_by_key(|&k| ctx.insert_schedules[k].next)
+    {
         let at = ctx.insert_schedules[k].next;
         // LIGGGHTS inserts at the start of step `at`: after step at - 1
         if at > cur + 1 {

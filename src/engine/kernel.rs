@@ -901,12 +901,12 @@ impl<N: NormalLaw, T: TangentialLaw, C: CohesionLaw, R: RollingLaw> Laws<N, T, C
         // most pairs touched at the last pass (a bed at rest): batches of
         // consecutive pairs, without a walk that sorts them out first
         let live = lv.iter().map(|&l| (l & 1) as usize).sum::<usize>();
-        let virial = if (3 * live >= 2 * lv.len() && lv.len() >= LANES) || (k.dense && !lv.is_empty()) {
+
+        if (3 * live >= 2 * lv.len() && lv.len() >= LANES) || (k.dense && !lv.is_empty()) {
             self.block_dense(k, h, d, lv, f, tq)
         } else {
             self.block_walk(k, h, d, lv, f, tq)
-        };
-        virial
+        }
     }
 
     /// A block's pairs in batches of [`LANES`] consecutive ones, touching
@@ -1744,7 +1744,7 @@ mod tests {
         // LIGGGHTS hertz + history; small mu on one type pair so that some
         // contacts slide and some stick
         let laws = Laws { normal: LiggghtsHertz, tangential: LiggghtsHistory, cohesion: NoCohesion, rolling: NoRolling };
-        assert!(Laws::<LiggghtsHertz, LiggghtsHistory, NoCohesion, NoRolling>::BATCHED);
+        const { assert!(Laws::<LiggghtsHertz, LiggghtsHistory, NoCohesion, NoRolling>::BATCHED) };
         let table = two_type_table(|q, s| {
             q.y_eff = 1e4 * s as f64;
             q.g_eff = 4e3 * s as f64;
@@ -1834,7 +1834,7 @@ mod tests {
             cohesion: Hamaker { tangential_reduce: false },
             rolling: PaperEpsd { torsion_torque: false },
         };
-        assert!(Laws::<PaperViscoelastic, PaperCundallStrack, Hamaker, PaperEpsd>::BATCHED);
+        const { assert!(Laws::<PaperViscoelastic, PaperCundallStrack, Hamaker, PaperEpsd>::BATCHED) };
         let table = two_type_table(|q, s| {
             q.y_eff = 1e4 * s as f64;
             q.g_eff = 4e3 * s as f64;

@@ -186,6 +186,7 @@ pub fn parse_mesh_transforms(cmd: &Command, words: &[Word]) -> Result<(Vec<MeshT
 }
 
 /// LIGGGHTS' value of pi in `fix mesh` rotations.
+#[allow(clippy::approx_constant)] // LIGGGHTS's own 9-digit value, on purpose
 pub const LIGGGHTS_PI: f64 = 3.14159265;
 
 impl MeshTransform {

@@ -470,6 +470,7 @@ impl Region {
     }
 
     /// Own frame -> current frame (points).
+    #[allow(clippy::wrong_self_convention)] // "from the local frame", not a constructor
     fn from_local(&self, x: V3) -> V3 {
         if self.motion.is_none() {
             return x;
@@ -849,7 +850,7 @@ impl Region {
             let mut win: Option<(V3, f64)> = None;
             for c in cands {
                 let d2 = (q - c).norm_squared();
-                if win.map_or(true, |(_, w)| d2 < w) {
+                if win.is_none_or(|(_, w)| d2 < w) {
                     win = Some((c, d2));
                 }
             }

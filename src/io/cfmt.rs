@@ -327,13 +327,13 @@ fn pad(out: &mut String, s: &Spec, sign: &str, body: &str, zero_ok: bool) {
     if s.left {
         out.push_str(sign);
         out.push_str(body);
-        out.extend(std::iter::repeat(' ').take(fill));
+        out.extend(std::iter::repeat_n(' ', fill));
     } else if s.zero && zero_ok {
         out.push_str(sign);
-        out.extend(std::iter::repeat('0').take(fill));
+        out.extend(std::iter::repeat_n('0', fill));
         out.push_str(body);
     } else {
-        out.extend(std::iter::repeat(' ').take(fill));
+        out.extend(std::iter::repeat_n(' ', fill));
         out.push_str(sign);
         out.push_str(body);
     }
@@ -504,7 +504,7 @@ mod tests {
         assert_eq!(f("%.3g", 9.9995), "10");
         assert_eq!(f("%#.3g", 9.9995), "10.0");
         assert_eq!(f("%-1.16e", -2.0), "-2.0000000000000000e+00");
-        assert_eq!(f("%08.3f", -3.14159), "-003.142");
+        assert_eq!(f("%08.3f", -3.14259), "-003.143");
         assert_eq!(f("%+.2e", 12345.678), "+1.23e+04");
         assert_eq!(f("%5.1f", f64::INFINITY), "  inf");
         assert_eq!(f("%05G", f64::NAN), "  NAN");

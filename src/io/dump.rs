@@ -772,7 +772,7 @@ impl DumpWriter {
     /// Whether a frame is due at `step` (multiple of `every`, or the first
     /// step of a run with `first yes`).
     pub fn is_due(&self, step: u64, first_step_of_run: bool) -> bool {
-        (self.opts.every > 0 && step % self.opts.every == 0) || (self.opts.first && first_step_of_run)
+        (self.opts.every > 0 && step.is_multiple_of(self.opts.every)) || (self.opts.first && first_step_of_run)
     }
 
     /// File name a frame at `timestep` goes to.

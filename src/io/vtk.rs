@@ -222,7 +222,7 @@ pub fn fmt_vtk_xml(x: f64) -> String {
 /// (of the tuples' L2 norms when there are several components, which also get
 /// VTK's `L2_NORM_RANGE` key), `1e+299`/`-1e+299` when empty.
 fn xml_array(o: &mut String, indent: &str, ty: &str, name: &str, ncomp: usize, vals: &[f64], text: impl Fn(f64) -> String) {
-    let n = if ncomp == 0 { 0 } else { vals.len() / ncomp };
+    let n = vals.len().checked_div(ncomp).unwrap_or(0);
     let (mut lo, mut hi) = (1e299_f64, -1e299_f64);
     for t in 0..n {
         let v = if ncomp == 1 { vals[t] } else { vals[t * ncomp..(t + 1) * ncomp].iter().map(|c| c * c).sum::<f64>().sqrt() };

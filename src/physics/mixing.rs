@@ -196,12 +196,14 @@ pub fn liggghts_pair_params(m: &LiggghtsMaterials, s: &LiggghtsSettings, span: S
 /// with those styles): `kt = None` (NULL) gives 2/7 Kn, `gamma_t = None`
 /// gives gamma_n / 2, dampflag 0 gives gamma_t = 0. Same for all type pairs.
 pub fn lammps_gran_params(kn: f64, kt: Option<f64>, gamma_n: f64, gamma_t: Option<f64>, xmu: f64, dampflag: bool, limit_damping: bool) -> PairParams {
-    let mut p = PairParams::default();
-    p.kn = kn;
-    p.kt = kt.unwrap_or(kn * 2.0 / 7.0);
-    p.gamma_n = gamma_n;
-    p.gamma_t = if dampflag { gamma_t.unwrap_or(0.5 * gamma_n) } else { 0.0 };
-    p.mu = xmu;
+    let mut p = PairParams {
+        kn,
+        kt: kt.unwrap_or(kn * 2.0 / 7.0),
+        gamma_n,
+        gamma_t: if dampflag { gamma_t.unwrap_or(0.5 * gamma_n) } else { 0.0 },
+        mu: xmu,
+        ..Default::default()
+    };
     p.tangential_damping = if dampflag { 1.0 } else { 0.0 };
     p.limit_damping = if limit_damping { 1.0 } else { 0.0 };
     p
@@ -334,12 +336,14 @@ pub fn lammps_granular_params(c: &GranularCoeff, wall: bool, span: Span) -> Resu
 /// left at 0), so F = sqrt(k_n,II k_n,JJ) delta; per the source the damping
 /// and tangential indices likewise stay `velocity` and `linear_nohistory`.
 pub fn lammps_granular_mix_2021(ii: &PairParams, jj: &PairParams) -> PairParams {
-    let mut p = PairParams::default();
-    p.kn = mix_geom(ii.kn, jj.kn);
-    p.gamma_n = mix_geom(ii.gamma_n, jj.gamma_n);
-    p.kt = mix_geom(ii.kt, jj.kt);
-    p.gamma_t = mix_geom(ii.gamma_t, jj.gamma_t);
-    p.mu = mix_geom(ii.mu, jj.mu);
+    let mut p = PairParams {
+        kn: mix_geom(ii.kn, jj.kn),
+        gamma_n: mix_geom(ii.gamma_n, jj.gamma_n),
+        kt: mix_geom(ii.kt, jj.kt),
+        gamma_t: mix_geom(ii.gamma_t, jj.gamma_t),
+        mu: mix_geom(ii.mu, jj.mu),
+        ..Default::default()
+    };
     p.k_roll = mix_geom(ii.k_roll, jj.k_roll);
     p.gamma_roll = mix_geom(ii.gamma_roll, jj.gamma_roll);
     p.mu_r = mix_geom(ii.mu_r, jj.mu_r);

@@ -529,7 +529,7 @@ pub fn parse_simple(sim: &Sim, id: &str, group: u32, style: &str, a: &mut Args, 
         "gravity" => {
             let magnitude = Magnitude::parse(a, "magnitude")?;
             let kind = a.choice("gravity style", &["vector", "spherical", "chute"])?;
-            let two_d = sim.domain.as_ref().map_or(false, |d| d.dimension == 2);
+            let two_d = sim.domain.as_ref().is_some_and(|d| d.dimension == 2);
             // `FixGravity::set_acceleration` of LAMMPS and LIGGGHTS alike: chute
             // is spherical with phi = 0 and theta = 180 - angle, so its axis is
             // -z in 3d and -y in 2d; neither is normalised (sin and cos as

@@ -14,8 +14,8 @@
 //! - insert/pack: count = int((f V - V_in) / V_expect + u) for
 //!   `volumefraction_region` (V from LIGGGHTS' Monte Carlo `volume_mc`, which
 //!   demx replays with the same Park-Miller stream, seed + 12, `ntry_mc`
-//!   points), N - N_in for `particles_in_region`, int((M - M_in) / M_expect
-//!   + u) for `mass_in_region`; u is the first draws of the fix's own
+//!   points), N - N_in for `particles_in_region`,
+//!   int((M - M_in) / M_expect + u) for `mass_in_region`; u is the first draws of the fix's own
 //!   Park-Miller stream (seed), as in LIGGGHTS, so counts match exactly. The
 //!   per-template split ("exact" mode, the default) draws from the
 //!   distribution's stream. The first insertion is the step after the fix is
@@ -447,7 +447,7 @@ impl Distribution {
         }
         let mut out = Vec::new();
         for &k in &self.order {
-            out.extend(std::iter::repeat(k).take(count[k]));
+            out.extend(std::iter::repeat_n(k, count[k]));
         }
         out
     }
@@ -982,7 +982,6 @@ fn parse_liggghts_insert(s: &Session, _cmd: &Command, id: &str, group: u32, styl
         return Err(Error::deck(style.span, lig(&st, id, "must not define both 'particlerate' and 'massrate'")));
     }
     let mut stream = None;
-    let mut insert_every = insert_every;
     if is_stream {
         let (f, sp, ie) = stream_face(s, &st, id, face, vel.1, extrude_length, duration, insert_every, &dist, style.span)?;
         insert_every = Some(ie);
@@ -1287,7 +1286,7 @@ impl LiggghtsInsert {
             }
         }
         // insertion fraction: first time, and every time on a shrink-wrapped box
-        let shrink = domain.sides.iter().any(|s| s.iter().any(|x| *x == crate::engine::domain::Side::Shrink));
+        let shrink = domain.sides.iter().any(|s| s.contains(&crate::engine::domain::Side::Shrink));
         if !f.fraction_done || shrink {
             f.fraction_done = true;
             let mut nin = 0usize;
@@ -1532,7 +1531,7 @@ impl Fix for LiggghtsInsert {
         // region outside the box with a fixed boundary
         if let Some((lo, hi)) = self.region.bbox() {
             let out = (0..3).any(|d| lo[d] < domain.lo[d] || hi[d] > domain.hi[d]);
-            let fixed = domain.sides.iter().any(|s| s.iter().any(|x| *x == crate::engine::domain::Side::Fixed));
+            let fixed = domain.sides.iter().any(|s| s.contains(&crate::engine::domain::Side::Fixed));
             if out && fixed {
                 return Err(Error::runtime(format!(
                     "Fix {} (id {}): Insertion region extends outside simulation box and a fixed boundary is used. Please use non-fixed boundaries in this case only",

@@ -497,8 +497,8 @@ impl Fix for WallGranMesh {
     /// frame when the lists were found, where M is the mesh's own allowance
     /// (half the skin; 0 for a mesh at rest). A triangle at distance D from
     /// the anchor is at least D - m from a centre m away from it, so a list
-    /// holds every triangle within reach while m stays under half the skin
-    /// + M; each step checks that per particle, and a particle past it
+    /// holds every triangle within reach while m stays under (half the
+    /// skin) + M; each step checks that per particle, and a particle past it
     /// searches the mesh's bins that step, and the lists are found again at
     /// the next. (The eighth of the skin left over, and a relative 1e-9 of
     /// the radius, cover the rounding of the distances.) The lists are found
@@ -928,7 +928,7 @@ impl Fix for WallGranRegion {
                 for k in 0..REGION_SLOTS {
                     if data[k * w + 3] != 0.0 && !used[k] {
                         let d = n.dot(&V3::new(data[k * w], data[k * w + 1], data[k * w + 2]));
-                        if d > 0.5 && best.map_or(true, |(_, b)| d > b) {
+                        if d > 0.5 && best.is_none_or(|(_, b)| d > b) {
                             best = Some((k, d));
                         }
                     }
@@ -1094,7 +1094,7 @@ fn mesh_dump_head<'c>(s: &Session, cmd: &'c Command, styles: &[&str]) -> Result<
     a.choice("dump style", styles)?;
     let every = a.i64("N")?;
     if every <= 0 {
-        return Err(a.err_prev(&format!("dump {}: N must be > 0", styles[0])));
+        return Err(a.err_prev(format!("dump {}: N must be > 0", styles[0])));
     }
     let file = a.word("file")?;
     Ok((MeshFrames { id: id.text.clone(), every, path: file.text.clone(), last_step: None }, file, a))

@@ -211,7 +211,7 @@ impl Session {
                 "map" | "first" | "id" => {
                     a.word("value")?;
                 }
-                _ => return Err(args::bad_keyword(&k, "atom_modify keyword", &["sort", "map", "first", "id"])),
+                _ => return Err(args::bad_keyword(k, "atom_modify keyword", &["sort", "map", "first", "id"])),
             }
         }
         Ok(())
@@ -369,7 +369,7 @@ impl Session {
         }
         // a positive number, or `off`
         fn limit(a: &mut Args, what: &str) -> Result<Option<f64>> {
-            if a.peek().map_or(false, |w| w.text == "off") {
+            if a.peek().is_some_and(|w| w.text == "off") {
                 a.pos += 1;
                 return Ok(None);
             }
@@ -547,7 +547,7 @@ impl Session {
 fn replayed(cmd: &Command) -> bool {
     match cmd.name() {
         "units" | "atom_style" | "pair_style" | "pair_coeff" | "hard_particles" | "dimension" => true,
-        "fix" => cmd.words.get(3).map_or(false, |w| w.text == "property/global"),
+        "fix" => cmd.words.get(3).is_some_and(|w| w.text == "property/global"),
         _ => false,
     }
 }
@@ -643,7 +643,7 @@ pub fn sniff_dialect(text: &str) -> Option<Dialect> {
         match (w.next(), w.next()) {
             (Some("pair_style"), Some("gran")) => return Some(Dialect::Liggghts),
             (Some("pair_style"), Some(st)) if st == "granular" || st.starts_with("gran/") => lammps = true,
-            (Some("fix"), Some(_)) => liggghts_fix |= w.nth(1).map_or(false, |st| st == "property/global"),
+            (Some("fix"), Some(_)) => liggghts_fix |= w.nth(1) == Some("property/global"),
             _ => {}
         }
     }

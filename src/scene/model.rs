@@ -582,7 +582,7 @@ pub fn parse_liggghts_model(a: &mut Args, spec: &mut PairSpec) -> Result<()> {
                     _ => return Err(bad_keyword(sfc, "surface model", &["default"])),
                 }
             }
-            _ if model_keyword(&k, a, spec)? => {}
+            _ if model_keyword(k, a, spec)? => {}
             _ => {
                 return Err(bad_keyword(
                     k,
@@ -1036,7 +1036,7 @@ pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: 
             s.props.insert(name.text.clone(), (kind.text.clone(), vals));
             Ok(())
         }
-        "property/atom" if a.rest().get(1).map_or(true, |w| !matches!(w.text.as_str(), "scalar" | "vector")) => {
+        "property/atom" if a.rest().get(1).is_none_or(|w| !matches!(w.text.as_str(), "scalar" | "vector")) => {
             Err(Error::unsupported(style.span, "LAMMPS-style fix property/atom (mol, q, i_/d_ per-atom properties)"))
         }
         "property/atom" => {

@@ -239,7 +239,7 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
             // (seen in its dumps of the liggghts-inl dump_custom_vtk deck). A
             // column restored from a restart keeps its originals, as the
             // engines' fix store does for the same compute id.
-            while a.more() {
+            if a.more() {
                 let k = a.word("displace/atom keyword")?;
                 return Err(Error::unsupported(k.span, format!("compute displace/atom keyword {}", k.text)));
             }
@@ -636,11 +636,11 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args, one_off: bool) -> 
                 if !known {
                     return Err(Error::deck(w.span, format!("dump custom: unknown column '{t}'")));
                 }
-                if t.starts_with("f_") {
+                if let Some(rest) = t.strip_prefix("f_") {
                     // per-atom properties demx keeps by name (fix
                     // property/atom, heat/gran's Temp...); other fixes'
                     // per-atom values are not available yet
-                    let (fid, col) = split_index(&t[2..]);
+                    let (fid, col) = split_index(rest);
                     if s.sim.particles.extra_index(fid).is_none() {
                         return Err(Error::unsupported(w.span, format!("dump custom column {t}")));
                     }

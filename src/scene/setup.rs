@@ -204,7 +204,7 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             s.sim.step = n;
             Ok(())
         }
-        "region" if cmd.args().get(1).map_or(false, |w| w.text == "delete") => {
+        "region" if cmd.args().get(1).is_some_and(|w| w.text == "delete") => {
             // `region ID delete`: later commands may define the ID afresh.
             // Fixes that took the region (insertion, forces) keep the copy
             // they took; a wall/gran/region, which LAMMPS looks up by name at
@@ -406,7 +406,7 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             while (points.len() as i64) < n && tries < 1000 * n.max(1) {
                 tries += 1;
                 let p = V3::new(lo.x + rng.uniform() * (hi.x - lo.x), lo.y + rng.uniform() * (hi.y - lo.y), lo.z + rng.uniform() * (hi.z - lo.z));
-                if region_filter.as_ref().map_or(true, |r| r.contains(p)) {
+                if region_filter.as_ref().is_none_or(|r| r.contains(p)) {
                     points.push(p);
                 }
             }
@@ -437,7 +437,7 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
             .ok_or_else(|| Error::deck(style.span, "create_atoms: no lattice defined").with_hint("define one with the lattice command"))?;
         let periodic = [dom.periodic(0), dom.periodic(1), dom.periodic(2)];
         let filter = region_filter.clone();
-        let f = move |p: V3| filter.as_ref().map_or(true, |r| r.contains(p));
+        let f = move |p: V3| filter.as_ref().is_none_or(|r| r.contains(p));
         let pts = lat.create_points(V3::from(dom.lo), V3::from(dom.hi), periodic, Some(&f)).map_err(|e| Error::deck(style.span, e.message()))?;
         points = pts.into_iter().map(|(p, _)| p).collect();
     }
@@ -449,10 +449,10 @@ fn create_atoms(s: &mut Session, cmd: &Command, a: &mut Args) -> Result<()> {
         ));
     }
     // LAMMPS default diameter 1, density 1 for atom_style sphere
-    let mut tag = s.sim.particles.max_tag();
+    let base = s.sim.particles.max_tag();
     let n = points.len();
-    for p in points {
-        tag += 1;
+    for (k, p) in points.into_iter().enumerate() {
+        let tag = base + k as i64 + 1;
         s.sim.particles.push(NewParticle { tag, kind: t as u32, mask: 1, x: p, v: V3::zeros(), omega: V3::zeros(), radius: 0.5, density: 1.0 });
     }
     s.sources.push(format!("create_atoms {} {}: {n} particles", t, style.text));

@@ -257,7 +257,7 @@ pub fn timestep_check(s: &Session) -> Option<TimestepCheck> {
             fraction_hertz: dt / th,
             particle: (r, rho),
         };
-        if best.as_ref().map_or(true, |b| c.fraction_rayleigh.max(c.fraction_hertz) > b.fraction_rayleigh.max(b.fraction_hertz)) {
+        if best.as_ref().is_none_or(|b| c.fraction_rayleigh.max(c.fraction_hertz) > b.fraction_rayleigh.max(b.fraction_hertz)) {
             best = Some(c);
         }
     }

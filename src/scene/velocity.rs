@@ -102,7 +102,7 @@ pub fn thermal(s: &mut Session, cmd: &Command, style: &Word, a: &mut Args, bit: 
     let o = options(s, a)?;
     let span = cmd.words[0].span;
     let sim = &mut s.sim;
-    if sim.particles.len() == 0 {
+    if sim.particles.is_empty() {
         return Err(Error::deck(span, "velocity command with no atoms existing"));
     }
     if let Some(seed) = seed {
@@ -140,7 +140,7 @@ fn triple(r: &mut Park, gaussian: bool) -> [f64; 3] {
 
 /// Sets each group atom's velocity to a draw times 1/sqrt(m), z = 0 in 2d.
 fn draw(sim: &mut Sim, bit: u32, seed: i32, o: &Options, span: crate::script::Span) -> Result<()> {
-    let dim3 = sim.domain.as_ref().map_or(true, |d| d.dimension == 3);
+    let dim3 = sim.domain.as_ref().is_none_or(|d| d.dimension == 3);
     let p = &mut sim.particles;
     let set = |p: &mut crate::engine::particles::Particles, i: usize, d: [f64; 3]| {
         let factor = 1.0 / p.mass[i].sqrt();

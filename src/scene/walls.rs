@@ -410,7 +410,7 @@ pub fn wall_gran(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &W
             let k = a.word("keyword")?;
             match k.text.as_str() {
                 // LIGGGHTS 3.8 takes model keywords after the geometry too
-                _ if model::model_keyword(&k, a, &mut spec)? => {}
+                _ if model::model_keyword(k, a, &mut spec)? => {}
                 "shear" | "store_force" | "store_force_contact" | "temperature" | "track_energy" | "contact_area" => {
                     return Err(Error::unsupported(k.span, format!("fix wall/gran keyword {}", k.text)))
                 }

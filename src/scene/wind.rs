@@ -23,7 +23,7 @@ fn positive(a: &mut Args, what: &str) -> Result<f64> {
 pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
     let _ = (style, vars);
     s.need_box(cmd)?;
-    if s.sim.domain.as_ref().map_or(false, |d| d.dimension != 3) {
+    if s.sim.domain.as_ref().is_some_and(|d| d.dimension != 3) {
         return Err(Error::deck(style.span, "fix aeolian/wind needs a 3d box (z is vertical)"));
     }
     let w = a.word("ustar")?;
@@ -102,7 +102,7 @@ pub fn fix(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a
                 } else {
                     let phic = positive(a, "phic")?;
                     let mut floor = None;
-                    if a.peek().map_or(false, |w| w.text == "floor") {
+                    if a.peek().is_some_and(|w| w.text == "floor") {
                         a.word("floor")?;
                         floor = Some(a.f64("floor height")?);
                     }
