@@ -4,10 +4,14 @@
 # behind DEMX_LONG=1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# formatting is part of the test (rustfmt.toml): a diff fails the run before
-# anything is built
+# formatting and lints are part of the test (rustfmt.toml; Cargo.toml's
+# [lints] says which clippy lints are allowed and why): a diff or a warning
+# fails the run before the tests are built
 cargo fmt --check
+cargo clippy --all-targets --quiet -- -D warnings
 bash scripts/setup.sh
+# the one-node Slurm cluster the Slurm backend's test submits to
+bash scripts/slurm_local.sh
 # Open MPI (under both engines, even on one rank) creates its session
 # directory /tmp/ompi.<host>.<uid> at start when it is missing, and an
 # engine's end may remove it again; two engines starting at once can race on

@@ -26,7 +26,10 @@
 //! Runs go one per core (`--jobs`, default 1), one thread each. `--stop`
 //! (or SIGTERM to the runner) asks every running run to stop at its next
 //! checkpoint; `--status` prints what is done, resumable and pending, with
-//! the core-hours left by the estimates.
+//! the core-hours left by the estimates. `--only RUN` runs just that run
+//! (what each task of the Slurm backend runs), holding `runs/RUN/runner.pid`
+//! instead of the campaign's lock. `--slurm` hands the unfinished runs to
+//! Slurm as one job array instead ([`super::slurm`]).
 
 use super::repose::{pick_frame, repose};
 use serde::{Deserialize, Serialize};
@@ -136,6 +139,12 @@ struct Cli {
     /// Extra arguments for every `demx run` (e.g. `--checkpoint-stop-after 2`, tests).
     #[arg(long, allow_hyphen_values = true)]
     run_arg: Vec<String>,
+    /// Run only this run (repeatable), here: what each task of `--slurm` runs.
+    #[arg(long)]
+    only: Vec<String>,
+    /// The Slurm backend.
+    #[command(flatten)]
+    slurm: super::slurm::SlurmOpts,
 }
 
 /// A campaign's folder, file and runs.
@@ -240,10 +249,22 @@ pub fn cli(args: Vec<String>) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Some(bad) = cli.only.iter().find(|n| !p.c.runs.iter().any(|r| &r.name == *n)) {
+        eprintln!("error: --only {bad}: the campaign {} declares no such run", cli.file.display());
+        return ExitCode::from(2);
+    }
+    if cli.slurm.slurm {
+        return submit_slurm(&p, &cli);
+    }
     if cli.stop {
         return match std::fs::write(p.dir.join("STOP"), "") {
             Ok(()) => {
                 println!("asked the campaign in {} to stop at its runs' next checkpoints", p.dir.display());
+                match super::slurm::jobs(&p.dir).and_then(|j| if j.is_empty() { Ok(0) } else { super::slurm::stop(&p.dir) }) {
+                    Ok(0) => {}
+                    Ok(n) => println!("and Slurm to stop its {n} live tasks (running ones checkpoint and stop, pending ones are cancelled)"),
+                    Err(e) => eprintln!("warning: Slurm: {e}"),
+                }
                 ExitCode::SUCCESS
             }
             Err(e) => {
@@ -259,10 +280,26 @@ pub fn cli(args: Vec<String>) -> ExitCode {
     run(&p, &cli)
 }
 
+/// The runs Slurm holds for this campaign (empty without submissions).
+fn queued(p: &Place) -> Result<BTreeMap<String, String>, String> {
+    let jobs = super::slurm::jobs(&p.dir)?;
+    if jobs.is_empty() {
+        return Ok(BTreeMap::new());
+    }
+    super::slurm::alive(&jobs)
+}
+
 fn print_status(p: &Place) {
     let (mut done, mut partial, mut pending, mut failed) = (0, 0, 0, 0);
     let mut left = 0.0;
+    let slurm = queued(p).unwrap_or_else(|e| {
+        eprintln!("warning: Slurm: {e}");
+        BTreeMap::new()
+    });
     for r in &p.c.runs {
+        if let Some(task) = slurm.get(&r.name) {
+            println!("{:<28} slurm task {task}", r.name);
+        }
         match state(p, r) {
             State::Done(o) => {
                 done += 1;
@@ -297,31 +334,119 @@ fn stop_asked(p: &Place) -> bool {
 /// The campaign's lock: the pid of the runner that holds it.
 const LOCK: &str = "runner.pid";
 
-/// Whether another live runner holds the campaign (its pid in [`LOCK`]).
-fn held_by_other(p: &Place) -> Option<i32> {
-    let pid: i32 = std::fs::read_to_string(p.dir.join(LOCK)).ok()?.trim().parse().ok()?;
+/// This machine's name, for the locks (a pid means nothing on another node).
+fn host() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname").map(|h| h.trim().to_string()).unwrap_or_default()
+}
+
+/// Whether another live runner on this machine holds the lock file `path`
+/// (`HOST PID`; an old lock holds only a pid). A lock written on another
+/// machine is not taken for held: under Slurm the queue, not the lock,
+/// keeps a run from starting twice, and a lost node leaves such locks.
+fn held_by_other(path: &Path) -> Option<i32> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut w = text.split_whitespace().rev();
+    let pid: i32 = w.next()?.parse().ok()?;
+    if w.next().is_some_and(|h| h != host()) {
+        return None;
+    }
     // SAFETY: signal 0 only asks whether the process exists
     let alive = pid > 0 && pid != std::process::id() as i32 && unsafe { libc::kill(pid, 0) } == 0;
     alive.then_some(pid)
 }
 
 fn run(p: &Place, cli: &Cli) -> ExitCode {
-    if let Some(pid) = held_by_other(p) {
+    if let Some(pid) = held_by_other(&p.dir.join(LOCK)) {
         eprintln!("error: the campaign in {} is already running (runner pid {pid}); `--stop` stops it", p.dir.display());
         return ExitCode::from(2);
     }
-    if let Err(e) = std::fs::write(p.dir.join(LOCK), std::process::id().to_string()) {
-        eprintln!("error: cannot write {}: {e}", p.dir.join(LOCK).display());
-        return ExitCode::from(1);
+    // the whole campaign, or (--only) just its named runs
+    let locks: Vec<PathBuf> = if cli.only.is_empty() {
+        vec![p.dir.join(LOCK)]
+    } else {
+        p.c.runs.iter().filter(|r| cli.only.contains(&r.name)).map(|r| p.run_dir(r).join(LOCK)).collect()
+    };
+    for l in &locks {
+        if let Some(pid) = held_by_other(l) {
+            eprintln!("error: {} is held by runner pid {pid}", l.display());
+            return ExitCode::from(2);
+        }
+    }
+    let me = format!("{} {}\n", host(), std::process::id());
+    for l in &locks {
+        if let Err(e) = l.parent().map_or(Ok(()), std::fs::create_dir_all).and_then(|_| std::fs::write(l, &me)) {
+            eprintln!("error: cannot write {}: {e}", l.display());
+            return ExitCode::from(1);
+        }
     }
     let code = run_locked(p, cli);
-    let _ = std::fs::remove_file(p.dir.join(LOCK));
+    for l in &locks {
+        let _ = std::fs::remove_file(l);
+    }
     code
+}
+
+/// `--slurm`: the unfinished runs Slurm does not already hold, as one job array.
+fn submit_slurm(p: &Place, cli: &Cli) -> ExitCode {
+    let live = match queued(p) {
+        Ok(q) => q,
+        Err(e) if cli.slurm.dry_run => {
+            eprintln!("warning: Slurm: {e}");
+            BTreeMap::new()
+        }
+        Err(e) => {
+            eprintln!("error: Slurm: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let mut tasks = vec![];
+    for r in &p.c.runs {
+        if live.contains_key(&r.name) || (!cli.only.is_empty() && !cli.only.contains(&r.name)) {
+            continue;
+        }
+        let remaining_h = match state(p, r) {
+            State::Pending => r.estimate_core_h,
+            State::Resumable { wall_s, .. } => (r.estimate_core_h - wall_s / 3600.0).max(0.0),
+            State::Done(_) | State::Failed(_) => continue,
+        };
+        tasks.push(super::slurm::Task { name: r.name.clone(), remaining_h });
+    }
+    if tasks.is_empty() {
+        println!("nothing to submit: {} runs queued or running in Slurm, the others done or failed (`--status`)", live.len());
+        return ExitCode::SUCCESS;
+    }
+    // a stop asked earlier is over once the runs are handed out again
+    let _ = std::fs::remove_file(p.dir.join("STOP"));
+    match super::slurm::submit(&cli.slurm, &cli.file, &tasks) {
+        Ok((path, None)) => {
+            print!("{}", std::fs::read_to_string(&path).unwrap_or_default());
+            println!("# job script written to {} ({} tasks); not submitted (--dry-run)", path.display(), tasks.len());
+            ExitCode::SUCCESS
+        }
+        Ok((path, Some(id))) => {
+            println!(
+                "submitted Slurm job {id}: {} tasks ({}), script {}; `demx campaign {} --status` follows them",
+                tasks.len(),
+                tasks.iter().map(|t| t.name.as_str()).collect::<Vec<_>>().join(", "),
+                path.display(),
+                cli.file.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err((code, e)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(code)
+        }
+    }
 }
 
 fn run_locked(p: &Place, cli: &Cli) -> ExitCode {
     crate::scene::checkpoint::catch_term();
-    let _ = std::fs::remove_file(p.dir.join("STOP"));
+    // a task of --only leaves the campaign's stop request to the others
+    let whole = cli.only.is_empty();
+    if whole {
+        let _ = std::fs::remove_file(p.dir.join("STOP"));
+    }
     let exe = match std::env::current_exe() {
         Ok(e) => e,
         Err(e) => {
@@ -335,7 +460,14 @@ fn run_locked(p: &Place, cli: &Cli) -> ExitCode {
             return ExitCode::from(2);
         }
     }
-    let mut queue: Vec<&RunSpec> = p.c.runs.iter().filter(|r| matches!(state(p, r), State::Resumable { .. } | State::Pending)).collect();
+    let mut queue: Vec<&RunSpec> =
+        p.c.runs
+            .iter()
+            .filter(|r| whole || cli.only.contains(&r.name))
+            .filter(|r| matches!(state(p, r), State::Resumable { .. } | State::Pending))
+            // a run another (--only) runner holds here
+            .filter(|r| held_by_other(&p.run_dir(r).join(LOCK)).is_none())
+            .collect();
     // unfinished runs first: their checkpoints are what a stop carries over
     queue.sort_by_key(|r| !matches!(state(p, r), State::Resumable { .. }));
     queue.truncate(cli.max_runs.unwrap_or(usize::MAX));
@@ -410,7 +542,9 @@ fn run_locked(p: &Place, cli: &Cli) -> ExitCode {
             }
         }
     }
-    let _ = std::fs::remove_file(p.dir.join("STOP"));
+    if whole {
+        let _ = std::fs::remove_file(p.dir.join("STOP"));
+    }
     print_status(p);
     if failures > 0 {
         ExitCode::from(1)

@@ -9,6 +9,7 @@ pub mod packing;
 pub mod reference;
 pub mod repose;
 pub mod saltation;
+pub mod slurm;
 pub mod sweep;
 pub mod tradeoff;
 

@@ -17,6 +17,12 @@
 //! Levenberg-Marquardt on the angles (radians), unweighted, with standard
 //! errors from s^2 (J^T J)^-1. A run whose `result.json` exists in its
 //! directory is reused, so an interrupted sweep resumes.
+//!
+//! `--slurm` runs the matrix on a cluster instead: it writes it as a
+//! campaign (`OUT/campaign.json`, runs in `OUT/runs/NAME/`, checkpointed and
+//! resumable) and submits it as one Slurm job array
+//! ([`super::slurm`]); `--collect` then measures what the tasks left and
+//! fits, running nothing. A local sweep reuses a run the cluster finished.
 
 use super::repose::{pick_frame, repose};
 use crate::plot::{Chart, Series, SeriesKind};
@@ -75,6 +81,12 @@ pub struct SweepCli {
     /// Particle density (kg/m^3) for the Bond number (Eq. 4).
     #[arg(long, default_value_t = 2500.0)]
     pub rho: f64,
+    /// Measure and fit the runs a `--slurm` submission finished; run nothing (unfinished runs are reported).
+    #[arg(long)]
+    pub collect: bool,
+    /// The Slurm backend.
+    #[command(flatten)]
+    pub slurm: super::slurm::SlurmOpts,
     /// Extra `-var` groups for every run (filled from the raw arguments).
     #[arg(skip)]
     pub vars: Vec<Vec<String>>,
@@ -384,6 +396,99 @@ pub fn parse(args: Vec<String>) -> Result<SweepCli, ExitCode> {
     Ok(c)
 }
 
+/// The campaign file a `--slurm` sweep writes in its folder.
+pub const CAMPAIGN: &str = "campaign.json";
+
+/// The sweep's matrix (g, d, seed), in its fixed order.
+fn matrix(c: &SweepCli) -> Vec<(f64, f64, i64)> {
+    let mut todo = vec![];
+    for &g in &c.g {
+        for &d in &c.d {
+            for k in 0..c.seeds {
+                todo.push((d, g, seed(k)));
+            }
+        }
+    }
+    todo
+}
+
+/// The matrix as a campaign: one run per (d, g, seed), named as the local
+/// sweep's folders, the `-var` groups as the campaign's variables.
+fn campaign(c: &SweepCli, deck: &Path) -> Result<super::campaign::Campaign, String> {
+    let mut vars = std::collections::BTreeMap::new();
+    for v in &c.vars {
+        if v.len() != 2 {
+            return Err(format!("-var {} has {} values; a campaign's variables take one", v[0], v.len() - 1));
+        }
+        vars.insert(v[0].clone(), v[1].clone());
+    }
+    let runs = matrix(c)
+        .into_iter()
+        .map(|(d, g, s)| super::campaign::RunSpec {
+            name: run_dir(d, g, s),
+            vars: [("d", format!("{d:e}")), ("g", g.to_string()), ("seed", s.to_string())].into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+            estimate_core_h: 0.0,
+            deck: None,
+            dump: None,
+            measure: None,
+        })
+        .collect();
+    Ok(super::campaign::Campaign { deck: deck.to_path_buf(), dump: c.dump.clone(), measure: "repose".into(), checkpoint_every_s: 600.0, vars, runs })
+}
+
+/// `--slurm`: write the campaign and hand it to the campaign's Slurm backend.
+fn submit_slurm(c: &SweepCli, deck: &Path) -> ExitCode {
+    let spec = match campaign(c, deck) {
+        Ok(s) => s,
+        Err(e) => return usage(e),
+    };
+    let file = c.out.join(CAMPAIGN);
+    let text = match serde_json::to_string_pretty(&spec) {
+        Ok(t) => t + "\n",
+        Err(e) => return usage(e),
+    };
+    // a campaign written before for another matrix is not silently replaced
+    if let Ok(old) = std::fs::read_to_string(&file) {
+        if old != text {
+            return usage(format!("{} holds another sweep's campaign; use another --out", file.display()));
+        }
+    }
+    if !write(&file, &text) {
+        return ExitCode::from(1);
+    }
+    let mut args: Vec<String> = vec![file.to_string_lossy().into_owned(), "--slurm".into()];
+    let o = &c.slurm;
+    if o.dry_run {
+        args.push("--dry-run".into());
+    }
+    for (k, v) in [("--partition", &o.partition), ("--account", &o.account), ("--time", &o.time), ("--mem", &o.mem)] {
+        if let Some(v) = v {
+            args.extend([k.to_string(), v.clone()]);
+        }
+    }
+    if let Some(f) = &o.sbatch_lines {
+        args.extend(["--sbatch-lines".to_string(), f.to_string_lossy().into_owned()]);
+    }
+    args.extend(["--cpus-per-task".to_string(), o.cpus_per_task.to_string(), "--checkpoint-lead-s".to_string(), o.checkpoint_lead_s.to_string()]);
+    super::campaign::cli(args)
+}
+
+/// A run the campaign of a `--slurm` sweep finished, measured from the last
+/// frame it kept (as [`one_run`] measures its own).
+fn from_campaign(c: &SweepCli, d: f64, g: f64, seed: i64) -> Option<Result<RunResult, String>> {
+    let dir = c.out.join("runs").join(run_dir(d, g, seed));
+    let text = std::fs::read_to_string(dir.join("result.json")).ok()?;
+    let measure = || -> Result<RunResult, String> {
+        let o: super::campaign::RunOutcome = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", dir.join("result.json").display()))?;
+        let dump = dir.join("final.dump.gz");
+        let frame = pick_frame(&dump.to_string_lossy(), None).map_err(|e| format!("{}: {e}", dump.display()))?;
+        let rep = repose(&frame).map_err(|e| format!("{}: {e}", dump.display()))?;
+        let y = c.vars.iter().find(|v| v[0] == "Y").map(|v| v[1..].join(" ")).unwrap_or_default();
+        Ok(RunResult { d, g, seed, theta: rep.theta, sd: rep.sd, n: rep.particles, y, wall: o.wall_s })
+    };
+    Some(measure())
+}
+
 /// Run (or reuse) one heap run; Ok(result) or the failure message.
 fn one_run(c: &SweepCli, deck: &Path, d: f64, g: f64, seed: i64) -> Result<RunResult, String> {
     let dir = c.out.join(run_dir(d, g, seed));
@@ -392,6 +497,12 @@ fn one_run(c: &SweepCli, deck: &Path, d: f64, g: f64, seed: i64) -> Result<RunRe
         if let Ok(r) = serde_json::from_str::<RunResult>(&text) {
             return Ok(r);
         }
+    }
+    if let Some(r) = from_campaign(c, d, g, seed) {
+        return r;
+    }
+    if c.collect {
+        return Err(format!("not finished (`demx campaign {} --status`)", c.out.join(CAMPAIGN).display()));
     }
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let exe = std::env::current_exe().map_err(|e| format!("cannot find the demx executable: {e}"))?;
@@ -422,14 +533,7 @@ fn one_run(c: &SweepCli, deck: &Path, d: f64, g: f64, seed: i64) -> Result<RunRe
 /// Run every (d, g, seed) J at a time; results in a fixed order (g, d, seed).
 pub fn run_all(c: &SweepCli) -> Vec<(f64, f64, i64, Result<RunResult, String>)> {
     let deck = std::fs::canonicalize(&c.deck).unwrap_or_else(|_| c.deck.clone());
-    let mut todo = vec![];
-    for &g in &c.g {
-        for &d in &c.d {
-            for k in 0..c.seeds {
-                todo.push((d, g, seed(k)));
-            }
-        }
-    }
+    let todo = matrix(c);
     let jobs = c.jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)).min(todo.len()).max(1);
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<Result<RunResult, String>>>> = Mutex::new(vec![None; todo.len()]);
@@ -594,6 +698,12 @@ pub fn cli(args: Vec<String>) -> ExitCode {
     };
     if let Err(e) = std::fs::create_dir_all(&c.out) {
         return usage(format!("cannot create {}: {e}", c.out.display()));
+    }
+    if c.slurm.slurm {
+        if c.collect {
+            return usage("--slurm submits, --collect gathers: one at a time");
+        }
+        return submit_slurm(&c, &std::fs::canonicalize(&c.deck).unwrap_or_else(|_| c.deck.clone()));
     }
     let all = run_all(&c);
     let mut runs = vec![];
