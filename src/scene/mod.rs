@@ -7,6 +7,7 @@
 pub mod args;
 pub mod checkpoint;
 pub mod commands;
+pub mod fix_styles;
 pub mod fixes;
 pub mod heat;
 pub mod insert;
@@ -311,19 +312,7 @@ impl Session {
             let gw = a.word("group")?;
             let style = a.word("fix style")?;
             let group = self.group(gw)?;
-            if style.text == "balance" {
-                // LAMMPS `fix ID group balance Nfreq thresh style args ...`: how
-                // MPI ranks share the box, nothing a single process does.
-                a.i64("Nfreq")?;
-                a.f64("thresh")?;
-                a.choice("balance style", &["shift", "rcb"])?;
-                self.notes.push((cmd.span, "fix balance: accepted; changes nothing in demx (single process, deterministic threads)".into()));
-                return self.add_fix(Box::new(fixes::Noop { id: id.text.clone(), style: style.text.clone() }));
-            }
-            if let Some(f) = fixes::parse_simple(&self.sim, &id.text, group, &style.text, &mut a, cmd)? {
-                return self.add_fix(f);
-            }
-            model::fix_command(self, cmd, &id.text, group, style, &mut a, vars)
+            fix_styles::dispatch(self, &fix_styles::FixCall { cmd, id: &id.text, group, style }, &mut a, vars)
         }
     }
 

@@ -15,7 +15,7 @@ use crate::physics::normal::{
 };
 use crate::physics::tangential::{self, granular::GranularTangential};
 use crate::physics::{CohesionLaw, NoCohesion, NoRolling, NormalLaw, PairParams, RollingLaw, TangentialLaw};
-use crate::script::{Command, Span, Variables, Word};
+use crate::script::{Command, Span, Word};
 
 /// Normal law of a scene.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -1018,9 +1018,9 @@ pub fn finalize(s: &mut Session, _cmd: &Command) -> Result<()> {
 
 // ---------------------------------------------------------------- fixes that need the model
 
-/// `fix property/global`, `fix wall/gran`, and the rest of the fix styles.
-pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: &Word, a: &mut Args, vars: &mut Variables) -> Result<()> {
-    let _ = vars;
+/// `fix property/global`, `property/atom`, `check/timestep/gran`,
+/// `enforce2d`, `momentum` (the fix styles [`super::fix_styles`] sends here).
+pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, style: &Word, a: &mut Args) -> Result<()> {
     match style.text.as_str() {
         "property/global" => {
             let name = a.word("property name")?;
@@ -1071,6 +1071,6 @@ pub fn fix_command(s: &mut Session, cmd: &Command, id: &str, group: u32, style: 
             s.notes.push((cmd.span, format!("fix {}: accepted; demx reports timestep criteria in `demx check`", style.text)));
             Ok(())
         }
-        _ => super::setup::extended_fix(s, cmd, id, group, style, a, vars),
+        _ => Err(Error::unsupported(style.span, format!("fix {}", style.text))),
     }
 }
