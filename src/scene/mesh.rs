@@ -720,16 +720,20 @@ impl Fix for WallGranMesh {
         self.summary.clone()
     }
     fn max_surface_overlap(&self, sim: &Sim) -> Option<(usize, f64)> {
-        // each mesh placed once for all particles
-        let guards: Vec<_> = self.meshes.iter().filter_map(|wm| wm.mesh.read().ok()).collect();
-        let placed: Vec<(&SurfaceMesh, Pose)> = guards.iter().map(|m| (&**m, m.pose(sim.time))).collect();
         let p = &sim.particles;
-        crate::engine::fix::deepest_overlap(sim, self.group, |i| deepest_triangle_overlap(&placed, p.x[i], p.radius[i]))
+        self.placed(sim, |placed| crate::engine::fix::deepest_overlap(sim, self.group, |i| deepest_triangle_overlap(placed, p.x[i], p.radius[i])))
     }
     fn surface_overlap(&self, sim: &Sim, i: usize) -> Option<f64> {
+        self.placed(sim, |placed| deepest_triangle_overlap(placed, sim.particles.x[i], sim.particles.radius[i]))
+    }
+}
+
+impl WallGranMesh {
+    /// `f` of the meshes, each read-locked and placed at its pose once.
+    fn placed<R>(&self, sim: &Sim, f: impl FnOnce(&[(&SurfaceMesh, Pose)]) -> R) -> R {
         let guards: Vec<_> = self.meshes.iter().filter_map(|wm| wm.mesh.read().ok()).collect();
         let placed: Vec<(&SurfaceMesh, Pose)> = guards.iter().map(|m| (&**m, m.pose(sim.time))).collect();
-        deepest_triangle_overlap(&placed, sim.particles.x[i], sim.particles.radius[i])
+        f(&placed)
     }
 }
 
