@@ -32,6 +32,12 @@ pub enum ComputeKind {
         /// Name of the extra per-atom column of originals.
         column: String,
     },
+    /// `contact/atom` (LIGGGHTS): each atom's number of particle contacts,
+    /// distance <= r_i + r_j (compute_contact_atom.cpp: a pair counts for
+    /// both atoms when the atom whose neighbour list holds it is in the
+    /// group; demx counts a pair when either atom of it is the group's,
+    /// the same for group `all`). Walls are not counted.
+    ContactAtom,
     /// A style demx records (for `demx check`) but cannot evaluate.
     Other(String),
 }
@@ -153,9 +159,31 @@ impl Compute {
                     })
                     .collect())
             }
+            ComputeKind::ContactAtom => Ok(contacts_per_atom(sim, self.group)),
             _ => Err(format!("compute {} ({}) has no per-atom values", self.id, self.style)),
         }
     }
+}
+
+/// Contacts per particle: the pair list holds every pair that can touch
+/// before its next build, so the pairs in contact now are all in it.
+fn contacts_per_atom(sim: &Sim, group: u32) -> Vec<f64> {
+    let p = &sim.particles;
+    let pairs = &sim.pairs;
+    let mut n = vec![0.0; p.len()];
+    for k in 0..pairs.len() {
+        let (a, b) = (pairs.a[k] as usize, pairs.b[k] as usize);
+        if a >= p.len() || b >= p.len() || (p.mask[a] | p.mask[b]) & group == 0 {
+            continue;
+        }
+        let d = p.x[a] - (p.x[b] + pairs.shift(k));
+        let rs = p.radius[a] + p.radius[b];
+        if d.norm_squared() <= rs * rs {
+            n[a] += 1.0;
+            n[b] += 1.0;
+        }
+    }
+    n
 }
 
 fn split_index(s: &str) -> (&str, Option<usize>) {

@@ -257,6 +257,17 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
             }
             ComputeKind::DisplaceAtom { column }
         }
+        // LIGGGHTS 3.8 and LAMMPS (GRANULAR) alike
+        "contact/atom" => {
+            if a.more() {
+                a.choice("contact/atom keyword", &["skin"])?;
+                let w = a.word("skin")?;
+                if super::args::parse_f64(w)? != 0.0 {
+                    return Err(Error::unsupported(w.span, "compute contact/atom skin other than 0 (contacts within a distance)"));
+                }
+            }
+            ComputeKind::ContactAtom
+        }
         other => {
             return Err(Error::unsupported(style.span, format!("compute {other}")));
         }

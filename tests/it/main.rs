@@ -19,6 +19,7 @@ mod cohesion_caps;
 mod compare_dumps;
 mod compare_engines;
 mod compare_heap;
+mod contact_atom;
 mod convert_corpus;
 mod convert_insert;
 mod displace_atom;
