@@ -533,7 +533,7 @@ impl Session {
 }
 
 /// Whether a command belongs in a restart file's replay list.
-fn replayed(cmd: &Command) -> bool {
+pub(crate) fn replayed(cmd: &Command) -> bool {
     match cmd.name() {
         "units" | "atom_style" | "pair_style" | "pair_coeff" | "hard_particles" | "dimension" => true,
         "fix" => cmd.words.get(3).is_some_and(|w| w.text == "property/global"),

@@ -171,17 +171,22 @@ impl RestartState {
     }
 
     /// Write atomically (temporary file + rename).
+    ///
+    /// Written to `.NAME.tmp` beside it and renamed: a run killed while
+    /// writing leaves the previous file whole, and its partial temporary
+    /// file is the one the next write of that name replaces (a random
+    /// temporary name was left behind for good).
     pub fn write(&self, path: &Path) -> std::io::Result<()> {
-        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+        let name = path.file_name().ok_or_else(|| std::io::Error::other("a restart file needs a file name"))?;
+        let tmp = path.with_file_name(format!(".{}.tmp", name.to_string_lossy()));
+        let f = std::fs::File::create(&tmp)?;
         {
-            let mut w = std::io::BufWriter::new(tmp.as_file_mut());
+            let mut w = std::io::BufWriter::new(&f);
             serde_json::to_writer(&mut w, self).map_err(std::io::Error::other)?;
             w.flush()?;
         }
-        tmp.as_file().sync_all()?;
-        tmp.persist(path).map_err(|e| e.error)?;
-        Ok(())
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
     }
 
     /// Read a restart file.
@@ -196,6 +201,70 @@ impl RestartState {
             return Err(format!("restart format '{}' (expected {FORMAT})", st.format));
         }
         Ok(st)
+    }
+
+    /// What a run needs of the values, as the deck commands that made them
+    /// would have checked (a crafted or damaged file hung the run on mass 0
+    /// or an inverted box and panicked on a short per-atom column, a
+    /// per-atom width 0 or a type above ntypes): the first value that is
+    /// not, named with its particle.
+    fn check_values(&self) -> std::result::Result<(), String> {
+        if !(1..=i32::MAX as usize).contains(&self.ntypes) {
+            return Err(format!("restart file: {} atom types (1 to {} possible)", self.ntypes, i32::MAX));
+        }
+        let bytes = 2.0 * ((self.ntypes + 1) as f64).powi(2) * std::mem::size_of::<crate::physics::PairParams>() as f64;
+        if !crate::limits::fits(bytes) {
+            return Err(format!("restart file: {} atom types need {}; {}", self.ntypes, crate::limits::human(bytes), crate::limits::machine()));
+        }
+        if !matches!(self.dimension, 2 | 3) {
+            return Err(format!("restart file: dimension {} (2 or 3)", self.dimension));
+        }
+        for d in 0..3 {
+            let (lo, hi) = (self.lo[d], self.hi[d]);
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) || !(self.lo0[d].is_finite() && self.hi0[d].is_finite()) {
+                return Err(format!("restart file: box {lo} to {hi} along axis {d} (finite, lo < hi)"));
+            }
+        }
+        if !(self.dt.is_finite() && self.dt > 0.0) || !self.time.is_finite() || self.step < 0 {
+            return Err(format!("restart file: step {}, time {}, time step {} (step >= 0, dt > 0, finite)", self.step, self.time, self.dt));
+        }
+        if self.groups.len() > 32 {
+            return Err(format!("restart file: {} groups (at most 32)", self.groups.len()));
+        }
+        for i in 0..self.tag.len() {
+            let finite = |v: &[f64; 3]| v.iter().all(|c| c.is_finite());
+            let bad = if self.kind[i] < 1 || self.kind[i] as usize > self.ntypes {
+                Some(format!("type {} (1 to {})", self.kind[i], self.ntypes))
+            } else if !(self.mass[i] > 0.0 && self.mass[i].is_finite()) {
+                Some(format!("mass {} (> 0)", self.mass[i]))
+            } else if !(self.radius[i] > 0.0 && self.radius[i].is_finite()) {
+                Some(format!("radius {} (> 0)", self.radius[i]))
+            } else if !(self.density[i] > 0.0 && self.density[i].is_finite()) {
+                Some(format!("density {} (> 0)", self.density[i]))
+            } else if !(finite(&self.x[i]) && finite(&self.v[i]) && finite(&self.omega[i])) {
+                Some("a position, velocity or angular velocity that is not finite".to_string())
+            } else {
+                None
+            };
+            if let Some(b) = bad {
+                return Err(format!("restart file: particle {} has {b}", self.tag[i]));
+            }
+        }
+        for e in &self.extra {
+            if e.width == 0 || e.data.len() != e.width * self.tag.len() || e.default.len() != e.width {
+                return Err(format!(
+                    "restart file: per-atom property '{}' has width {} and {} values for {} particles (width >= 1, width x particles values, width defaults)",
+                    e.name,
+                    e.width,
+                    e.data.len(),
+                    self.tag.len()
+                ));
+            }
+        }
+        if self.pair_width > 64 {
+            return Err(format!("restart file: {} history values per pair (at most 64)", self.pair_width));
+        }
+        Ok(())
     }
 
     /// Put the state into a simulation (replacing particles and box).
@@ -218,6 +287,7 @@ impl RestartState {
         if !ok || self.sides.len() != 6 {
             return Err("restart file is inconsistent (column lengths differ)".into());
         }
+        self.check_values()?;
         let mut sides = [[Side::Periodic; 2]; 3];
         let cs: Vec<char> = self.sides.chars().collect();
         for d in 0..3 {
@@ -299,6 +369,14 @@ impl RestartState {
         sim.force_rebuild = self.stale;
         sim.resume = !self.stale;
         Ok(())
+    }
+}
+
+/// At most 80 characters of `text`, for a message.
+fn cut(text: &str) -> String {
+    match text.char_indices().nth(80) {
+        Some((k, _)) => format!("{}...", &text[..k]),
+        None => text.to_string(),
     }
 }
 
@@ -400,6 +478,12 @@ pub fn execute(s: &mut Session, cmd: &Command, vars: &mut Variables) -> Result<(
             for text in replay {
                 let words: Vec<Word> = text.split_whitespace().map(|t| Word::new(t, Span::DUMMY)).collect();
                 let c = Command { words, span: Span::DUMMY };
+                // only what a restart carries (units, styles, the contact
+                // model, materials): a crafted file's `fix print ... file`
+                // would otherwise run
+                if !super::replayed(&c) {
+                    return Err(Error::deck(w.span, format!("restart file replays '{}', which a restart file does not carry", cut(&text))));
+                }
                 s.execute_replay(&c, vars)?;
             }
             Ok(())
@@ -519,6 +603,9 @@ mod tests {
     fn restart_round_trips_every_float_exactly() {
         let mut sim = Sim::default();
         sim.domain = Some(Domain::new([0.0; 3], [1.0; 3], [[Side::Periodic; 2]; 3], 3));
+        // what create_box and timestep give a run (a restart checks them)
+        sim.ntypes = 1;
+        sim.dt = 1e-6;
         let mut rng = Park::new(4711);
         let n = 2000;
         for k in 0..n {

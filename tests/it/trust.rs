@@ -247,3 +247,55 @@ fn dump_info_on_a_missing_file_exits_2_like_the_other_tools() {
     assert_eq!(code, Some(2), "{out}");
     assert!(out.contains("missing.dump"), "{out}");
 }
+
+/// A restart file crafted or damaged in one value is refused with exit 2
+/// naming what is wrong, before anything runs: values that hung the run
+/// (mass 0, an inverted box) or panicked it (a short or zero-width
+/// per-atom column, a type above ntypes, 2^40 types), and a replay list
+/// that would run a command a restart does not carry (a `fix print ...
+/// file` creating a file).
+#[test]
+fn crafted_restart_files_are_refused_before_they_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // a valid restart with a per-atom property column
+    let write = deck("fix pa all property/atom tag1 scalar yes no no 0.\nrun 10\nwrite_restart r.json");
+    std::fs::write(d.join("in.write"), write).unwrap();
+    // what a write killed half way leaves: the next write of the name replaces it
+    std::fs::write(d.join(".r.json.tmp"), "{\"format\": ").unwrap();
+    let (code, out) = demx(d, &["run", "in.write", "--log", "none"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(!d.join(".r.json.tmp").exists(), "a killed write's temporary file is left behind");
+    let valid: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("r.json")).unwrap()).unwrap();
+    let read = "atom_style granular\natom_modify map array\nnewton off\ncommunicate single vel yes\nunits si\nread_restart r.bad\n\
+neighbor 0.0002 bin\nfix integr all nve/sphere\nrun 10\n";
+    std::fs::write(d.join("in.read"), read).unwrap();
+    // the untouched file reads and runs
+    std::fs::write(d.join("r.bad"), valid.to_string()).unwrap();
+    let (code, out) = demx(d, &["run", "in.read", "--log", "none"]);
+    assert_eq!(code, Some(0), "the valid restart: {out}");
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit, &str); 8] = [
+        ("mass 0", |v| v["mass"][0] = 0.0.into(), "mass 0"),
+        ("inverted box", |v| v["hi"][2] = (-1.0).into(), "lo < hi"),
+        ("type above ntypes", |v| v["kind"][0] = 7.into(), "type 7"),
+        ("2^40 types", |v| v["ntypes"] = (1u64 << 40).into(), "atom types"),
+        ("short per-atom column", |v| v["extra"][0]["data"] = serde_json::json!([]), "per-atom property"),
+        ("per-atom width 0", |v| v["extra"][0]["width"] = 0.into(), "width 0"),
+        ("negative time step", |v| v["dt"] = (-1e-6).into(), "dt > 0"),
+        (
+            "a replayed command that writes a file",
+            |v| v["replay"].as_array_mut().unwrap().push("fix p all print 1 hi file pwned.txt".into()),
+            "does not carry",
+        ),
+    ];
+    for (what, edit, expect) in cases {
+        let mut v = valid.clone();
+        edit(&mut v);
+        std::fs::write(d.join("r.bad"), v.to_string()).unwrap();
+        let (code, out) = demx(d, &["run", "in.read", "--log", "none"]);
+        assert_eq!(code, Some(2), "{what}: {out}");
+        assert!(out.contains("in.read:6:") && out.contains(expect), "{what}: {out}");
+    }
+    assert!(!d.join("pwned.txt").exists(), "the replayed fix print ran");
+}
