@@ -110,9 +110,14 @@ fn slurm_array_with_a_killed_task_matches_the_local_backend() {
     let again = demx(&slurm, &["campaign", "c.json", "--slurm"]);
     assert!(String::from_utf8_lossy(&again.stdout).contains("nothing to submit"), "{}", said(&again));
 
-    // the local backend meanwhile (its two jobs share the two cores with Slurm's tasks)
-    let lo = demx(&local, &["campaign", "c.json", "--jobs", "2"]);
-    assert!(lo.status.success(), "{}", said(&lo));
+    // the local backend meanwhile (its two jobs share the cores with Slurm's tasks)
+    let lo = Command::new(env!("CARGO_BIN_EXE_demx"))
+        .current_dir(&local)
+        .args(["campaign", "c.json", "--jobs", "2"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start the local campaign");
 
     // the victim: the last task, its runner and its run killed with SIGKILL
     // (as when its node is lost) once the run has checkpointed past its start
@@ -124,7 +129,7 @@ fn slurm_array_with_a_killed_task_matches_the_local_backend() {
     let file = slurm.join("c.json").canonicalize().unwrap();
     let ckpt = victim.join("ckpt").canonicalize().unwrap();
     for pattern in [format!("{} --only r3", file.display()), format!("--checkpoint {}", ckpt.display())] {
-        let kill = Command::new("pkill").args(["-KILL", "-f", &pattern]).output().unwrap();
+        let kill = Command::new("pkill").args(["-KILL", "-f", "--", &pattern]).output().unwrap();
         assert!(kill.status.success(), "no process matched {pattern}: {}", said(&kill));
     }
     wait_until("the first array to end", 900, || live_tasks(&job).is_empty());
@@ -141,6 +146,8 @@ fn slurm_array_with_a_killed_task_matches_the_local_backend() {
     let st = demx(&slurm, &["campaign", "c.json", "--status"]);
     assert!(String::from_utf8_lossy(&st.stdout).contains("4 done"), "{}", said(&st));
 
+    let lo = lo.wait_with_output().unwrap();
+    assert!(lo.status.success(), "the local backend: {}", said(&lo));
     for k in 0..4 {
         let (a, b) = (local.join(format!("runs/r{k}")), slurm.join(format!("runs/r{k}")));
         assert!(final_frame(&a) == final_frame(&b), "run r{k}: the Slurm run's last frame differs from the local one's");
