@@ -85,7 +85,10 @@ def main():
         engine = "lmp" if r["engine"].startswith("lmp") else "liggghts"
         np_ = re.search(r"-np (\d+)", r["engine"])
         with tempfile.TemporaryDirectory() as tmp:
-            mine, theirs = os.path.join(tmp, "demx"), os.path.join(tmp, "engine")
+            # each copy keeps the folder's own name: decks name it in
+            # relative paths (`log ../DEM/log.liggghts`)
+            base = os.path.basename(folder)
+            mine, theirs = os.path.join(tmp, "demx", base), os.path.join(tmp, "engine", base)
             shutil.copytree(folder, mine)
             shutil.copytree(folder, theirs)
             ecmd = ([] if not np_ else ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", np_.group(1)]) + [engine, "-in", deck, "-log", "none"]
