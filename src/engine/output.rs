@@ -256,10 +256,16 @@ impl Thermo {
         let mut s = String::new();
         for k in &self.keywords {
             let name = match self.dialect {
-                // LIGGGHTS prints c_ID / f_ID / v_ID headers without the prefix
+                // LIGGGHTS 3.8 prints c_ID / f_ID / v_ID headers without the
+                // prefix and cut to 8 characters (`f_heattransfer` ->
+                // `heattran`, `c_centreofmass[3]` -> `centreof`; seen in
+                // its output)
                 Dialect::Liggghts => {
                     let h = header_name(k);
-                    h.strip_prefix("c_").or_else(|| h.strip_prefix("f_")).or_else(|| h.strip_prefix("v_")).map(str::to_string).unwrap_or(h)
+                    match h.strip_prefix("c_").or_else(|| h.strip_prefix("f_")).or_else(|| h.strip_prefix("v_")) {
+                        Some(id) => id.chars().take(8).collect(),
+                        None => h,
+                    }
                 }
                 Dialect::Lammps => header_name(k),
             };

@@ -638,6 +638,16 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args, one_off: bool) -> 
     }
     let file = a.word("file")?;
     let engine = if s.sim.dialect == Dialect::Liggghts { Engine::Liggghts } else { Engine::Lammps };
+    // LIGGGHTS 3.8 creates the folders of a dump's file name when the dump
+    // is defined (`dump ... post/dump*.vtk` with no post/: the engine makes
+    // it, seen with custom and custom/vtk); LAMMPS stops with "Cannot open
+    // dump file". demx check writes nothing.
+    if engine == Engine::Liggghts && !(s.check || s.sim.dry || s.replaying) {
+        if let Some(dir) = std::path::Path::new(&file.text).parent().filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| Error::io(file.span, format!("dump {}: cannot create the folder {}", id.text, dir.display()), &e))?;
+        }
+    }
     let (opts, columns) = match style.text.as_str() {
         "custom" | "custom/gz" | "custom/vtk" => {
             let mut cols = vec![];

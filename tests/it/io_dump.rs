@@ -312,3 +312,42 @@ fn engines_read_dump_accepts_written_files() {
         assert_eq!(positions(&back[0]), positions(&src[3]));
     }
 }
+
+/// A LIGGGHTS deck dumping into a folder that does not exist: LIGGGHTS 3.8
+/// creates it when the dump is defined (custom and custom/vtk alike), so
+/// demx does too and writes the same files; LAMMPS 2021 stops ("Cannot open
+/// dump file"), and so does demx on a LAMMPS deck. `demx check` creates
+/// nothing.
+#[test]
+fn liggghts_dumps_create_their_folders_as_the_engine_does() {
+    let deck = "atom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\nunits si\n\
+region reg block 0 0.01 0 0.01 0 0.01 units box\ncreate_box 1 reg\nneighbor 0.0002 bin\n\
+fix m1 all property/global youngsModulus peratomtype 1.e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\nfix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+pair_style gran model hertz tangential history\npair_coeff * *\ntimestep 1e-6\n\
+create_atoms 1 single 0.005 0.005 0.005 units box\nset atom 1 diameter 0.002 density 2500\nfix integr all nve/sphere\n\
+dump d all custom 5 post/deep/d*.txt id x y z\nrun 10\n";
+    let b = crate::common::engine_and_demx("liggghts", "in.deck", &[("in.deck", deck)]);
+    let names = |d: &Path| -> Vec<String> {
+        let mut v: Vec<String> =
+            std::fs::read_dir(d.join("post/deep")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        v.sort();
+        v
+    };
+    assert_eq!(names(b.theirs.path()), ["d0.txt", "d10.txt", "d5.txt"], "LIGGGHTS made the folder and wrote three frames");
+    assert_eq!(names(b.ours.path()), names(b.theirs.path()));
+    // check writes nothing: no folder either
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("in.deck"), deck).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_demx")).current_dir(dir.path()).args(["check", "in.deck"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!dir.path().join("post").exists(), "demx check created the dump's folder");
+    // a LAMMPS deck does not get its folder (the engine stops)
+    let lammps = "units si\natom_style sphere\nboundary f f f\nregion box block 0 0.01 0 0.01 0 0.01\ncreate_box 1 box\n\
+create_atoms 1 single 0.005 0.005 0.005\nset type 1 diameter 0.001 density 2500\ncomm_modify vel yes\n\
+pair_style gran/hooke 2e5 NULL 50 NULL 0.5 0\npair_coeff * *\nfix 1 all nve/sphere\ntimestep 1e-5\n\
+dump d all custom 5 sub/d.txt id x\nrun 10\n";
+    std::fs::write(dir.path().join("in.lammps"), lammps).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_demx")).current_dir(dir.path()).args(["run", "in.lammps", "--log", "none"]).output().unwrap();
+    assert!(!o.status.success() && !dir.path().join("sub").exists(), "a LAMMPS deck's dump folder was made: {}", String::from_utf8_lossy(&o.stderr));
+}

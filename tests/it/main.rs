@@ -71,6 +71,7 @@ mod slurm;
 mod stability;
 mod stability_guard;
 mod sweep_heap;
+mod thermo_headers;
 mod tradeoff;
 mod trust;
 mod tutorials_run;
