@@ -589,14 +589,18 @@ fn finish(p: &Place, r: &RunSpec) -> Result<RunOutcome, String> {
     if matches!(p.measure(r), "packing" | "both") {
         phi = Some(super::packing::packing(&frame).map_err(|e| format!("{}: {e}", dump.display()))?.phi);
     }
-    let log = std::fs::read_to_string(work.join("log.demx")).unwrap_or_default();
-    let particle_steps = particle_steps(&log);
     let segs_path = dir.join("ckpt").join("segments.json");
     let segments: Vec<crate::scene::checkpoint::Segment> = std::fs::read_to_string(&segs_path)
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
         .ok_or_else(|| format!("{} is missing", segs_path.display()))?;
     let wall_s: f64 = segments.iter().map(|s| s.wall_s).sum();
+    // counted by each stretch where its checkpoints carry the count (the log
+    // of a stretch on another machine is not here); else the log's runs
+    let particle_steps = match segments.iter().map(|s| s.particle_steps).collect::<Option<Vec<f64>>>() {
+        Some(each) => each.iter().sum(),
+        None => particle_steps(&std::fs::read_to_string(work.join("log.demx")).unwrap_or_default()),
+    };
     let o = RunOutcome {
         name: r.name.clone(),
         vars: p.vars(r),

@@ -338,7 +338,7 @@ pub fn main() -> ExitCode {
                 Ok(()) => {
                     // finished: the checkpoint has nothing left to resume
                     if let Some(c) = &s.checkpoints {
-                        if let Err(e) = c.finish(s.sim.step, threads) {
+                        if let Err(e) = c.finish(s.sim.step, threads, s.sim.particle_steps) {
                             eprintln!("error: checkpoint folder {}: {e}", c.dir.display());
                             return ExitCode::from(1);
                         }

@@ -14,6 +14,8 @@ pub struct Logger {
     pub screen: bool,
     /// The log file, flushed after every line.
     pub file: Option<File>,
+    /// Its path as opened (a checkpoint records it with the file's length).
+    pub path: Option<std::path::PathBuf>,
     /// Whether a progress line is currently shown on the terminal.
     progress_shown: bool,
     /// Whether stderr is a terminal (progress lines only then).
@@ -26,7 +28,15 @@ pub struct Logger {
 
 impl Default for Logger {
     fn default() -> Self {
-        Logger { screen: true, file: None, progress_shown: false, tty: std::io::stderr().is_terminal(), captured: None, last_progress: None }
+        Logger {
+            screen: true,
+            file: None,
+            path: None,
+            progress_shown: false,
+            tty: std::io::stderr().is_terminal(),
+            captured: None,
+            last_progress: None,
+        }
     }
 }
 
@@ -66,6 +76,7 @@ impl Logger {
     pub fn open(&mut self, path: &str, append: bool) -> std::io::Result<()> {
         let f = if append { std::fs::OpenOptions::new().create(true).append(true).open(path)? } else { File::create(path)? };
         self.file = Some(f);
+        self.path = Some(std::path::PathBuf::from(path));
         Ok(())
     }
 }

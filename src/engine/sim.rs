@@ -132,6 +132,10 @@ pub struct Sim {
     pub boltz: f64,
     /// Steps per second of the last run.
     pub last_rate: f64,
+    /// Particle-steps integrated by this process: over its runs, steps times
+    /// the atoms at the run's end, as each run's "Loop time" line counts them
+    /// (also for runs with `post no`, which print no such line).
+    pub particle_steps: f64,
     /// Time spent per section of the last run: pair, neigh, modify, output.
     pub timing: [f64; 4],
     /// Time the current step's pair pass took (part of its tail when the
@@ -187,6 +191,7 @@ impl Default for Sim {
             setup_pass: false,
             boltz: 1.3806504e-23,
             last_rate: 0.0,
+            particle_steps: 0.0,
             timing: [0.0; 4],
             pass_secs: 0.0,
             walked: 0,
@@ -494,6 +499,7 @@ impl Sim {
         }
         let secs = t0.elapsed().as_secs_f64();
         self.last_rate = if secs > 0.0 { n as f64 / secs } else { 0.0 };
+        self.particle_steps += n as f64 * self.particles.len() as f64;
         if post {
             self.log.line(&self.run_summary(n, secs));
         }

@@ -84,6 +84,10 @@ pub struct Segment {
     pub wall_s: f64,
     /// Threads it ran on.
     pub threads: usize,
+    /// Particle-steps it integrated ([`crate::engine::sim::Sim::particle_steps`];
+    /// none in checkpoints from before this field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub particle_steps: Option<f64>,
 }
 
 /// A checkpoint file.
@@ -96,6 +100,13 @@ struct Saved {
     fixes: Vec<(String, String, serde_json::Value)>,
     dumps: Vec<SavedDump>,
     segments: Vec<Segment>,
+    /// The log file (absolute path) and its length at the checkpoint: a
+    /// resumed run cuts it back there, as it does the dumps, so that lines the
+    /// stopped stretch wrote after the checkpoint (a run's "Loop time" line
+    /// among them) are not there twice. Checkpoints from before this field
+    /// have none and leave the log as it is.
+    #[serde(default)]
+    log: Option<(PathBuf, u64)>,
 }
 
 /// A dump at a checkpoint: its id, its file and length when the resumed run
@@ -175,9 +186,9 @@ impl Checkpoints {
 
     /// The run finished: remove the checkpoint, keep the stretches in
     /// `DIR/segments.json` (which binary ran which steps, how long).
-    pub fn finish(&self, step: i64, threads: usize) -> std::io::Result<()> {
+    pub fn finish(&self, step: i64, threads: usize, particle_steps: f64) -> std::io::Result<()> {
         std::fs::create_dir_all(&self.dir)?;
-        let text = serde_json::to_string_pretty(&self.all_segments(step, threads)).map_err(std::io::Error::other)?;
+        let text = serde_json::to_string_pretty(&self.all_segments(step, threads, particle_steps)).map_err(std::io::Error::other)?;
         std::fs::write(self.dir.join("segments.json"), text + "\n")?;
         match std::fs::remove_file(self.file()) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
@@ -221,9 +232,16 @@ impl Checkpoints {
     }
 
     /// The stretches so far, this process's included (up to `step`).
-    pub fn all_segments(&self, step: i64, threads: usize) -> Vec<Segment> {
+    pub fn all_segments(&self, step: i64, threads: usize, particle_steps: f64) -> Vec<Segment> {
         let mut v = self.segments.clone();
-        v.push(Segment { demx: build_id(), from_step: self.started.1, to_step: step, wall_s: self.started.0.elapsed().as_secs_f64(), threads });
+        v.push(Segment {
+            demx: build_id(),
+            from_step: self.started.1,
+            to_step: step,
+            wall_s: self.started.0.elapsed().as_secs_f64(),
+            threads,
+            particle_steps: Some(particle_steps),
+        });
         v
     }
 }
@@ -287,8 +305,9 @@ pub fn write(s: &mut Session, saved: &SavedInterpreter) -> Result<bool> {
         return Ok(false);
     }
     let threads = s.threads;
+    let log = log_at_checkpoint(s);
     let cp = s.checkpoints.as_mut().expect("checked above");
-    let segments = cp.all_segments(s.sim.step, threads);
+    let segments = cp.all_segments(s.sim.step, threads, s.sim.particle_steps);
     let saved = Saved {
         format: FORMAT.into(),
         interp: saved.clone(),
@@ -297,6 +316,7 @@ pub fn write(s: &mut Session, saved: &SavedInterpreter) -> Result<bool> {
         fixes,
         dumps,
         segments,
+        log,
     };
     std::fs::create_dir_all(&cp.dir).map_err(|e| Error::io(Span::DUMMY, format!("cannot create '{}'", cp.dir.display()), &e))?;
     let path = cp.file();
@@ -307,6 +327,12 @@ pub fn write(s: &mut Session, saved: &SavedInterpreter) -> Result<bool> {
     cp.stopped = stop;
     s.sim.log.line(&format!("demx: checkpoint at step {} written to {}", s.sim.step, path.display()));
     Ok(stop)
+}
+
+/// The log file and its length now, where there is one.
+fn log_at_checkpoint(s: &Session) -> Option<(PathBuf, u64)> {
+    let len = s.sim.log.file.as_ref()?.metadata().ok()?.len();
+    Some((s.sim.log.path.as_ref()?.canonicalize().ok()?, len))
 }
 
 /// Serialize, gzip and write atomically (temporary file beside, renamed).
@@ -386,6 +412,18 @@ pub fn resume(s: &mut Session, r: Resume) -> Result<SavedInterpreter> {
         }
         d.resume_at(*last, file.is_some());
     }
-    s.sim.log.line(&format!("demx: resumed from the checkpoint at step {step}"));
+    // the log, cut back where it is the file the checkpoint measured
+    let mut cut = String::new();
+    if let (Some((path, len)), Some(now)) = (&saved.log, log_at_checkpoint(s)) {
+        if *path == now.0 && now.1 >= *len {
+            if let Some(f) = &s.sim.log.file {
+                f.set_len(*len).map_err(|e| Error::io(Span::DUMMY, format!("cannot cut log '{}' back", path.display()), &e))?;
+                if now.1 > *len {
+                    cut = format!(" (the {} bytes the stopped stretch logged after it were cut)", now.1 - len);
+                }
+            }
+        }
+    }
+    s.sim.log.line(&format!("demx: resumed from the checkpoint at step {step}{cut}"));
     Ok(saved.interp)
 }

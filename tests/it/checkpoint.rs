@@ -146,6 +146,52 @@ fn sigterm_stops_at_a_checkpoint_and_the_run_continues_exactly() {
     assert!(log.contains("demx: resumed from the checkpoint at step"), "the log tells the resume");
 }
 
+/// A run that dies after a run line ended (its "Loop time" summary in the
+/// log) and before the next checkpoint: the resumed run does that run
+/// again, and the log is cut back to the checkpoint, so the summary is there
+/// once, as in the uninterrupted run (a Slurm task killed in that window had
+/// counted the run twice in the campaign's particle-steps). Here the death
+/// is an `include` of a file that is not there yet; it is there for the
+/// resume.
+#[test]
+fn a_run_that_dies_between_checkpoints_logs_each_run_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut text = std::fs::read_to_string(root().join("tests/decks/restart/in.column")).unwrap();
+    text = text.replace("restart ${restart_every} restart.*\nrun ${steps}\n", "");
+    text.push_str("run 100\nrun 100\ninclude part2.in\nrun 100\n");
+    std::fs::write(d.join("in.column"), text).unwrap();
+    let vars: Vec<String> = ["-var", "every", "100", "-var", "name", "c"].map(String::from).to_vec();
+    let args = ["--checkpoint", "ckpt", "--checkpoint-every", "0", "--log", "log.demx"];
+    let o = demx(d, &d.join("in.column"), &vars, &args);
+    assert_eq!(o.status.code(), Some(2), "the missing include ends the run: {}", said(&o));
+    let died = std::fs::read_to_string(d.join("log.demx")).unwrap();
+    assert_eq!(died.matches("Loop time of").count(), 2, "{died}");
+    std::fs::write(d.join("part2.in"), "thermo 50\n").unwrap();
+    let o = demx(d, &d.join("in.column"), &vars, &args);
+    assert!(o.status.success(), "{}", said(&o));
+    let log = std::fs::read_to_string(d.join("log.demx")).unwrap();
+    assert_eq!(log.matches("Loop time of").count(), 3, "each run's summary once: {log}");
+    assert!(log.contains("demx: resumed from the checkpoint at step 100 (the "), "{log}");
+    // the dump and the log's thermo lines are the uninterrupted run's
+    let a = tempfile::tempdir().unwrap();
+    std::fs::copy(d.join("in.column"), a.path().join("in.column")).unwrap();
+    std::fs::copy(d.join("part2.in"), a.path().join("part2.in")).unwrap();
+    let o = demx(a.path(), &a.path().join("in.column"), &vars, &["--log", "log.demx"]);
+    assert!(o.status.success(), "{}", said(&o));
+    same_file(a.path(), d, "dump.c");
+    let thermo = |t: &str| t.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).map(str::to_string).collect::<Vec<_>>();
+    let whole = std::fs::read_to_string(a.path().join("log.demx")).unwrap();
+    assert_eq!(thermo(&whole), thermo(&log));
+    // the stretches' particle-steps (what a campaign reports, also when the
+    // log of a stretch stayed on another machine) add up to the runs' count
+    let segs: Vec<serde_json::Value> = serde_json::from_str(&std::fs::read_to_string(d.join("ckpt/segments.json")).unwrap()).unwrap();
+    assert_eq!(segs.len(), 2, "{segs:?}");
+    let counted: f64 = segs.iter().map(|s| s["particle_steps"].as_f64().expect("each stretch counts")).sum();
+    assert_eq!(counted, demx::analysis::campaign::particle_steps(&whole), "{segs:?}");
+    assert!(counted > 0.0);
+}
+
 /// A fix whose state a checkpoint cannot keep yet: no checkpoint is taken
 /// (the log says why, once), and the run goes on to its end.
 #[test]
