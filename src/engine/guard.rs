@@ -11,6 +11,17 @@
 //!   step (|v| dt > travel R), and, if set, that no particle is faster than
 //!   `speed`.
 //!
+//! An overlap beyond the limit stops the run only where the deck set the
+//! limit (`demx_guard overlap F`). Otherwise it is a warning, once per run
+//! (the same diagnosis: contacts, time step against the contact times,
+//! placement or insertion), and overlaps are not checked again in that run:
+//! LIGGGHTS and LAMMPS run decks that insert grains across a wall, or whose
+//! time step spans a contact in two steps, and five third-party decks of the
+//! corpus (COMPAT.md) do; demx with the overlap check off agreed with the
+//! engine there. A time step too large for the stiffness still stops a run
+//! when the collision it cannot resolve throws the grains apart (travel).
+//! Non-finite values, travel and speed always stop.
+//!
 //! A failing check stops the run with [`Error::Runtime`] (exit code 1) and a
 //! message naming the particle id, the step, the contact involved (partner
 //! id or wall, overlap as a fraction of the radius) and the likely cause
@@ -69,6 +80,9 @@ pub struct GuardSettings {
     pub enabled: bool,
     /// Overlap limit as a fraction of the radius (None: not checked).
     pub overlap: Option<f64>,
+    /// Whether the deck set the overlap limit (`demx_guard overlap F`): an
+    /// overlap beyond it then stops the run whatever the time step.
+    pub overlap_set: bool,
     /// Limit on |v| dt / R (None: not checked).
     pub travel: Option<f64>,
     /// Absolute speed limit in the deck's velocity units (None: not checked).
@@ -84,6 +98,7 @@ impl Default for GuardSettings {
         GuardSettings {
             enabled: true,
             overlap: Some(DEFAULT_OVERLAP),
+            overlap_set: false,
             travel: Some(DEFAULT_TRAVEL),
             speed: None,
             every: DEFAULT_EVERY,
@@ -135,6 +150,9 @@ pub struct Guard {
     /// (smaller id, larger id, overlap fraction) of pairs overlapping at the
     /// start of the current run, sorted.
     setup_overlaps: Vec<(i64, i64, f64)>,
+    /// An overlap was warned about in the current run: overlaps are not
+    /// checked again until the next run.
+    overlap_warned: bool,
 }
 
 /// What a check found.
@@ -169,14 +187,45 @@ pub fn check(sim: &mut Sim, at_setup: bool) -> crate::error::Result<()> {
     }
     if at_setup {
         note_setup_overlaps(sim);
+        sim.guard.overlap_warned = false;
     }
-    match find_trip(sim, true) {
+    let mut trip = find_trip(sim, !sim.guard.overlap_warned);
+    if let Some(t @ (Trip::PairOverlap(..) | Trip::WallOverlap(..))) = &trip {
+        if !overlap_stops(&sim.guard) {
+            warn(sim, t, at_setup);
+            sim.guard.overlap_warned = true;
+            trip = find_trip(sim, false);
+        }
+    }
+    match trip {
         None => {
             take_snapshot(sim);
             Ok(())
         }
         Some(t) => Err(fail(sim, t, at_setup)),
     }
+}
+
+/// Whether an overlap beyond the limit stops the run: where the deck set
+/// the limit (see the module's text).
+fn overlap_stops(g: &Guard) -> bool {
+    g.settings.overlap_set
+}
+
+/// Log an overlap that does not stop the run (once per run); on stderr too
+/// when the screen is off, as demx's other physics warnings.
+fn warn(sim: &mut Sim, trip: &Trip, at_setup: bool) {
+    let text = describe(sim, trip, at_setup);
+    let lim = sim.guard.settings.overlap.unwrap_or(DEFAULT_OVERLAP);
+    let line = format!(
+        "WARNING (demx): {text}\n  LIGGGHTS and LAMMPS run on with such an overlap, and so does demx; \
+         overlaps are not checked again in this run (`demx_guard overlap {lim}` stops a run at an overlap beyond {})",
+        pct(lim)
+    );
+    if !sim.log.screen {
+        eprintln!("{line}");
+    }
+    sim.log.line(&line);
 }
 
 /// Called by `rebuild` when particles are about to be dropped as lost
@@ -443,20 +492,20 @@ fn contacts_of(sim: &Sim, i: usize) -> Vec<(String, f64)> {
     out
 }
 
-/// Build the error for a trip, write the last good state and flush outputs.
-fn fail(sim: &mut Sim, trip: Trip, at_setup: bool) -> Error {
+/// What a trip is, where, the particle's contacts and the likely cause.
+fn describe(sim: &Sim, trip: &Trip, at_setup: bool) -> String {
     let p = &sim.particles;
     let g = &sim.guard;
     let step = sim.step;
     let when = if at_setup { format!("at the start of the run (step {step})") } else { format!("at step {step}") };
     let i = match trip {
-        Trip::NonFinite(i, _) | Trip::PairOverlap(i, _, _) | Trip::WallOverlap(i, _, _) | Trip::Travel(i, _) | Trip::Speed(i, _) => i,
+        Trip::NonFinite(i, _) | Trip::PairOverlap(i, _, _) | Trip::WallOverlap(i, _, _) | Trip::Travel(i, _) | Trip::Speed(i, _) => *i,
     };
     let tag = p.tag[i];
     let r = p.radius[i];
     let mut msg = String::from("stability guard: ");
     let mut partner: Option<usize> = None;
-    match &trip {
+    match trip {
         Trip::NonFinite(_, what) => {
             msg.push_str(&format!("particle {tag} has a non-finite {what} {when}"));
         }
@@ -555,6 +604,14 @@ fn fail(sim: &mut Sim, trip: Trip, at_setup: bool) -> Error {
         }
     }
     msg.push_str(&format!("\n  likely cause: {}", causes.join("; ")));
+    msg
+}
+
+/// Build the error for a trip, write the last good state and flush outputs.
+fn fail(sim: &mut Sim, trip: Trip, at_setup: bool) -> Error {
+    let mut msg = describe(sim, &trip, at_setup);
+    let g = &sim.guard;
+    let step = sim.step;
     // last good state
     match g.settings.file.clone() {
         Some(file) => match write_last_good(sim, &file) {

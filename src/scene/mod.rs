@@ -378,7 +378,11 @@ impl Session {
                     }
                     g.enabled = false;
                 }
-                "overlap" => g.overlap = limit(&mut a, "overlap (fraction of the radius)")?,
+                "overlap" => {
+                    g.overlap = limit(&mut a, "overlap (fraction of the radius)")?;
+                    // a limit the deck sets stops the run (engine/guard.rs)
+                    g.overlap_set = true;
+                }
                 "travel" => g.travel = limit(&mut a, "travel (fraction of the radius per step)")?,
                 "speed" => g.speed = limit(&mut a, "speed")?,
                 "every" => {

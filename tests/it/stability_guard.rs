@@ -2,6 +2,8 @@
 //! code 1, a message naming the particle, the step, the contact and the likely
 //! cause, and leaves the last good state as a data file; `demx_guard off`
 //! lets the same run finish; a sane deck runs bitwise as with the guard off.
+//! An overlap with a time step that resolves the contacts is a warning (the
+//! engines run such decks) unless the deck sets the limit.
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -153,17 +155,33 @@ fn small_timestep_collision_passes_and_matches_the_unguarded_run() {
     assert!(msg.contains("contacts of particle 1 (radius 0.001; overlaps as fractions of the smaller radius): particle 2 (overlap "), "{msg}");
 }
 
+/// An overlapping placement with a time step that resolves the contact:
+/// LIGGGHTS and LAMMPS run it, so demx warns (once, naming the pair and the
+/// cause) and runs on; a limit the deck sets stops it there.
 #[test]
-fn overlapping_placement_is_stopped_at_setup() {
+fn overlapping_placement_is_warned_and_stopped_where_the_deck_sets_the_limit() {
     // centres 1.2 R apart: overlap 0.8 R
     let dir = tempfile::tempdir().expect("tempdir");
-    let deck = headon(1e-6, "")
-        .replace("create_atoms 1 single -0.006", "create_atoms 1 single -0.0006")
-        .replace("create_atoms 1 single 0.006", "create_atoms 1 single 0.0006");
-    let out = run(dir.path(), &deck);
+    let deck = |extra: &str| {
+        headon(1e-6, extra)
+            .replace("create_atoms 1 single -0.006", "create_atoms 1 single -0.0006")
+            .replace("create_atoms 1 single 0.006", "create_atoms 1 single 0.0006")
+    };
+    let out = run(dir.path(), &deck(""));
+    let msg = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "{msg}");
+    let said = "particles 1 and 2 overlap by 80% of the smaller radius at the start of the run (step 0)";
+    assert_eq!(msg.matches("WARNING (demx): stability guard: ").count(), 1, "{msg}");
+    assert!(msg.contains(said) && msg.contains("overlapping placement") && msg.contains("not checked again in this run"), "{msg}");
+    assert!(!dir.path().join("demx.lastgood.data").exists());
+    // the pair was pushed apart: the run went on
+    let out = run(dir.path(), &(deck("") + "write_data end.data\n"));
+    let df = demx::io::data::read_data(dir.path().join("end.data")).expect("final state");
+    assert!((df.atoms[0].x[0] - df.atoms[1].x[0]).abs() > 0.0012, "{:?} {}", df.atoms, stderr(&out));
+    let out = run(dir.path(), &deck("demx_guard overlap 0.75"));
     let msg = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{msg}");
-    assert!(msg.contains("particles 1 and 2 overlap by 80% of the smaller radius at the start of the run (step 0)"), "{msg}");
+    assert!(msg.contains(said), "{msg}");
     assert!(msg.contains("overlapping placement"), "{msg}");
     assert!(!msg.contains("timestep too large"), "{msg}");
     let df = demx::io::data::read_data(dir.path().join("demx.lastgood.data")).expect("state written");
@@ -244,9 +262,14 @@ fn wall_deck(dt: f64, z0: f64) -> String {
 
 #[test]
 fn deep_wall_overlap_is_stopped_and_names_the_wall() {
-    // placed 0.8 R into the wall: stopped before the first step
+    // placed 0.8 R into the wall: a warning, naming the wall; with the
+    // limit set in the deck, stopped before the first step
     let dir = tempfile::tempdir().expect("tempdir");
     let out = run(dir.path(), &wall_deck(1e-6, 0.0002));
+    let msg = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "{msg}");
+    assert!(msg.contains("WARNING (demx): stability guard: particle 1 overlaps wall (fix floor"), "{msg}");
+    let out = run(dir.path(), &wall_deck(1e-6, 0.0002).replace("run 200", "demx_guard overlap 0.75\nrun 200"));
     let msg = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{msg}");
     assert!(msg.contains("particle 1 overlaps wall (fix floor"), "{msg}");
@@ -269,4 +292,51 @@ fn deep_wall_overlap_is_stopped_and_names_the_wall() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = run(dir.path(), &wall_deck(0.02 * th, z0));
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+}
+
+/// Grains placed deep into walls (a mesh plate and a primitive plane, 78% to
+/// 100% of their radius), as decks that insert with `all_in no` have them:
+/// LIGGGHTS 3.8 runs the deck and pushes them out; demx warns once and
+/// follows it step for step (issue #52: the guard stopped such decks).
+#[test]
+fn grains_placed_into_walls_run_as_liggghts_resolves_them() {
+    use crate::common;
+    let deck = "units si\natom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\n\
+region box block -0.001 0.009 -0.001 0.005 -0.002 0.05 units box\ncreate_box 1 box\n\
+create_atoms 1 single 0.001 0.001 0.0001 units box\ncreate_atoms 1 single 0.003 0.003 0.00003 units box\n\
+create_atoms 1 single 0.006 0.002 -0.00131 units box\ncreate_atoms 1 single 0.007 0.003 -0.001375 units box\n\
+set group all diameter 0.0009 density 2500\n\
+fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\n\
+fix cad all mesh/surface file plate.stl type 1\n\
+fix wall all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
+fix floor all wall/gran model hertz tangential history primitive type 1 zplane -0.0014\n\
+fix g all gravity 9.81 vector 0 0 -1\nvelocity all set 0.01 0.02 0\nfix 1 all nve/sphere\ntimestep 1e-6\n\
+thermo 500\nthermo_style custom step atoms ke\n\
+dump d all custom 500 dump.walls id x y z vx vy vz\ndump_modify d format \"%d %.17g %.17g %.17g %.17g %.17g %.17g\"\n\
+run 3000\n";
+    let b = common::engine_and_demx("liggghts", "in.walls", &[("in.walls", deck), ("plate.stl", &common::plate_stl("0"))]);
+    assert_eq!(b.ours_out.matches("WARNING (demx): stability guard: ").count(), 1, "{}", b.ours_out);
+    assert!(b.ours_out.contains("overlaps wall (fix "), "{}", b.ours_out);
+    let (theirs, ours) = (common::dump_frames(&b.theirs.path().join("dump.walls")), common::dump_frames(&b.ours.path().join("dump.walls")));
+    assert_eq!(theirs.len(), 7, "frames");
+    assert_eq!(theirs.keys().collect::<Vec<_>>(), ours.keys().collect::<Vec<_>>());
+    for (step, rows) in &theirs {
+        assert_eq!(rows.len(), 4, "step {step}");
+        for (id, t) in rows {
+            let o = &ours[step][id];
+            for k in 0..6 {
+                let scale = if k < 3 { 1e-3 } else { t[3..].iter().fold(1e-3_f64, |m, v| m.max(v.abs())) };
+                assert!((t[k] - o[k]).abs() <= 1e-9 * scale, "step {step} atom {id} column {k}: liggghts {} demx {}", t[k], o[k]);
+            }
+        }
+    }
+    // pushed out: every grain ends above its wall and touches it no deeper than 10% of its radius
+    let last = &theirs[&3000];
+    for (id, t) in last {
+        let wall = if t[0] < 0.0045 { 0.0 } else { -0.0014 };
+        assert!(t[2] - wall > 0.9 * 0.00045, "atom {id} at z {} over the wall at {wall}", t[2]);
+    }
 }
