@@ -77,6 +77,7 @@ fix_styles! {
     // walls and meshes
     "wall/gran" => Runs(wall_gran), "wall/gran/region" => MESH, "mesh/surface" => MESH,
     "mesh/surface/planar" => MESH, "mesh/surface/stress" => MESH, "move/mesh" => MESH,
+    "massflow/mesh" => Runs(super::massflow::fix),
     // particles in
     "particletemplate/sphere" => INSERT, "particledistribution/discrete" => INSERT,
     "particledistribution/discrete/numberbased" => INSERT, "particledistribution/discrete/massbased" => INSERT,
@@ -91,7 +92,7 @@ fix_styles! {
     "particletemplate/multiplespheres" => Unsupported("only spheres are supported"),
     "insert/stream/predefined" => NOT_YET, "mesh/surface/stress/servo" => NOT_YET, "couple/cfd" => NOT_YET,
     "couple/cfd/force" => NOT_YET, "couple/cfd/force/implicit" => NOT_YET, "multisphere" => NOT_YET,
-    "massflow/mesh" => NOT_YET, "ave/euler" => NOT_YET, "property/atom/tracer" => NOT_YET,
+    "ave/euler" => NOT_YET, "property/atom/tracer" => NOT_YET,
     "property/atom/tracer/stream" => NOT_YET, "wall/region/sph" => NOT_YET, "insert/pack/dense" => NOT_YET,
     "nve/sphere/omp" => NOT_YET, "ave/chunk" => NOT_YET, "ave/atom" => NOT_YET, "ave/histo" => NOT_YET,
     "ave/correlate" => NOT_YET, "deform" => NOT_YET, "rigid" => NOT_YET, "rigid/small" => NOT_YET,

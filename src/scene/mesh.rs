@@ -120,7 +120,7 @@ pub fn find_mesh(s: &Session, id: &str) -> Option<SharedMesh> {
     s.sim.fixes.iter().filter(|f| f.id() == id).find_map(|f| f.as_any().and_then(|a| a.downcast_ref::<MeshSurfaceFix>()).map(|m| m.mesh.clone()))
 }
 
-fn need_mesh(s: &Session, w: &Word) -> Result<SharedMesh> {
+pub(crate) fn need_mesh(s: &Session, w: &Word) -> Result<SharedMesh> {
     find_mesh(s, &w.text).ok_or_else(|| {
         let ids: Vec<&str> = s.sim.fixes.iter().filter(|f| f.style().starts_with("mesh/surface")).map(|f| f.id()).collect();
         let mut e = Error::deck(w.span, format!("fix mesh/surface '{}' does not exist", w.text));

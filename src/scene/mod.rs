@@ -11,6 +11,7 @@ pub mod fix_styles;
 pub mod fixes;
 pub mod heat;
 pub mod insert;
+pub mod massflow;
 pub mod mesh;
 pub mod model;
 pub mod outputs;

@@ -52,6 +52,7 @@ mod issue_3_restart;
 mod issue_3_threads;
 mod issue_4_paper_deck;
 mod legacy_run;
+mod massflow;
 mod mesh_stress;
 mod mesh_vtk;
 mod mesh_walls;
