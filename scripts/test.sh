@@ -50,6 +50,9 @@ done
 # tests), each rustc peaking near 12 GB at opt-level 1 (every contact-law
 # combination is its own kernel): on a machine under 32 GB two at once were
 # killed for memory (2026-12-07, 24 GB), so there they go one at a time.
+# CI builds from a clean checkout: incremental compilation's caches only
+# cost there (written, never read again).
+export CARGO_INCREMENTAL=0
 jobs=()
 mem_kb=$(awk '/^MemTotal:/ {print $2}' /proc/meminfo 2>/dev/null || echo 0)
 if [ "${mem_kb:-0}" -lt 33554432 ]; then
