@@ -274,7 +274,7 @@ pub fn cli(args: Vec<String>) -> ExitCode {
         };
     }
     if cli.status {
-        print_status(&p);
+        print_status(&p, &[]);
         return ExitCode::SUCCESS;
     }
     run(&p, &cli)
@@ -289,7 +289,10 @@ fn queued(p: &Place) -> Result<BTreeMap<String, String>, String> {
     super::slurm::alive(&jobs)
 }
 
-fn print_status(p: &Place) {
+/// The campaign's table: a line per run (only the runs of `only`, where
+/// given: a Slurm task's output names its own run, not the whole campaign)
+/// and the totals.
+fn print_status(p: &Place, only: &[String]) {
     let (mut done, mut partial, mut pending, mut failed) = (0, 0, 0, 0);
     let mut left = 0.0;
     let slurm = queued(p).unwrap_or_else(|e| {
@@ -297,29 +300,36 @@ fn print_status(p: &Place) {
         BTreeMap::new()
     });
     for r in &p.c.runs {
+        let shown = only.is_empty() || only.contains(&r.name);
+        // a line of the table, for the runs shown
+        let line = |text: String| {
+            if shown {
+                println!("{:<28} {text}", r.name);
+            }
+        };
         if let Some(task) = slurm.get(&r.name) {
-            println!("{:<28} slurm task {task}", r.name);
+            line(format!("slurm task {task}"));
         }
         match state(p, r) {
             State::Done(o) => {
                 done += 1;
                 let th = o.theta_deg.map_or(String::new(), |t| format!("theta_r {t:.2} ± {:.2}°  ", o.theta_sd_deg.unwrap_or(f64::NAN)));
                 let phi = o.phi.map_or(String::new(), |f| format!("phi {f:.4}  "));
-                println!("{:<28} done       {th}{phi}{:.2} core-h", r.name, o.core_hours);
+                line(format!("done       {th}{phi}{:.2} core-h", o.core_hours));
             }
             State::Resumable { step, wall_s } => {
                 partial += 1;
                 left += (r.estimate_core_h - wall_s / 3600.0).max(0.0);
-                println!("{:<28} resumable  at step {step}, {:.2} core-h spent of ~{:.1}", r.name, wall_s / 3600.0, r.estimate_core_h);
+                line(format!("resumable  at step {step}, {:.2} core-h spent of ~{:.1}", wall_s / 3600.0, r.estimate_core_h));
             }
             State::Failed(m) => {
                 failed += 1;
-                println!("{:<28} FAILED     {m}", r.name);
+                line(format!("FAILED     {m}"));
             }
             State::Pending => {
                 pending += 1;
                 left += r.estimate_core_h;
-                println!("{:<28} pending    ~{:.1} core-h", r.name, r.estimate_core_h);
+                line(format!("pending    ~{:.1} core-h", r.estimate_core_h));
             }
         }
     }
@@ -545,7 +555,7 @@ fn run_locked(p: &Place, cli: &Cli) -> ExitCode {
     if whole {
         let _ = std::fs::remove_file(p.dir.join("STOP"));
     }
-    print_status(p);
+    print_status(p, &cli.only);
     if failures > 0 {
         ExitCode::from(1)
     } else if stopping {

@@ -281,6 +281,11 @@ fn campaign_resumes_from_its_folder_anywhere_and_matches_uninterrupted_runs() {
         }
     }
     std::fs::remove_dir_all(&first).unwrap();
+    // a runner of one run (as a Slurm task is) prints that run's line and the totals
+    let o = campaign(&second, &["--only", "b", "--run-arg=--checkpoint-stop-after", "--run-arg=1"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && out.lines().any(|l| l.starts_with("b ")) && !out.lines().any(|l| l.starts_with("a ")), "{}", said(&o));
+    assert!(out.contains("pending") || out.contains("resumable"), "{out}");
     let mut rounds = 0;
     loop {
         let st = campaign(&second, &["--status"]);
@@ -304,8 +309,11 @@ fn campaign_resumes_from_its_folder_anywhere_and_matches_uninterrupted_runs() {
             .iter()
             .flat_map(|(k, x)| ["-var".to_string(), k.to_string(), x.to_string()])
             .collect();
-        let o = demx(u.path(), &deck, &vars, &[]);
+        let o = demx(u.path(), &deck, &vars, &["--log", "log.demx"]);
         assert!(o.status.success(), "{}", said(&o));
+        // counted by the stretches, though the first folder's logs are gone
+        let whole = demx::analysis::campaign::particle_steps(&std::fs::read_to_string(u.path().join("log.demx")).unwrap());
+        assert_eq!(r["particle_steps"].as_f64(), Some(whole), "run {n}: particle-steps of the uninterrupted run");
         let full = std::fs::read_to_string(u.path().join("dump.heap")).unwrap();
         let last = &full[full.rfind("ITEM: TIMESTEP").unwrap()..];
         let mut kept = String::new();
