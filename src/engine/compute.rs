@@ -38,6 +38,17 @@ pub enum ComputeKind {
     /// group; demx counts a pair when either atom of it is the group's,
     /// the same for group `all`). Walls are not counted.
     ContactAtom,
+    /// `coord/atom cutoff [typeN ...]` (LAMMPS's compute_coord_atom.cpp in
+    /// the form LIGGGHTS 3.8 has): for each atom of the group, the other
+    /// atoms of any group whose centre is closer than `cutoff` (strictly),
+    /// one column per type range (`2`, `1*3`, `*`); all types without any.
+    /// Atoms outside the group get 0.
+    CoordAtom {
+        /// Cutoff distance.
+        cutoff: f64,
+        /// Inclusive type ranges, one per column.
+        types: Vec<(u32, u32)>,
+    },
     /// A style demx records (for `demx check`) but cannot evaluate.
     Other(String),
 }
@@ -160,6 +171,24 @@ impl Compute {
                     .collect())
             }
             ComputeKind::ContactAtom => Ok(contacts_per_atom(sim, self.group)),
+            ComputeKind::CoordAtom { cutoff, types } => {
+                let k = match col {
+                    None if types.len() == 1 => 1,
+                    None => {
+                        return Err(format!(
+                            "compute {} ({}) has {} columns: use c_{}[1..{}]",
+                            self.id,
+                            self.style,
+                            types.len(),
+                            self.id,
+                            types.len()
+                        ))
+                    }
+                    Some(k) if (1..=types.len()).contains(&k) => k,
+                    Some(k) => return Err(format!("compute {} has no column {k} (coord/atom here has {})", self.id, types.len())),
+                };
+                Ok(coordination(sim, self.group, *cutoff, types[k - 1]))
+            }
             _ => Err(format!("compute {} ({}) has no per-atom values", self.id, self.style)),
         }
     }
@@ -184,6 +213,90 @@ fn contacts_per_atom(sim: &Sim, group: u32) -> Vec<f64> {
         }
     }
     n
+}
+
+/// Neighbours closer than `cutoff` of each atom of `group`, counting those
+/// with a type in `types` (any group), by a grid of cells of side `cutoff`
+/// (periodic sides by the nearest image).
+fn coordination(sim: &Sim, group: u32, cutoff: f64, types: (u32, u32)) -> Vec<f64> {
+    let p = &sim.particles;
+    let n = p.len();
+    let mut out = vec![0.0; n];
+    if n == 0 || !(cutoff > 0.0) {
+        return out;
+    }
+    let (lo, hi, periodic) = match &sim.domain {
+        Some(d) => (d.lo, d.hi, [0, 1, 2].map(|k| d.periodic(k))),
+        None => ([0.0; 3], [0.0; 3], [false; 3]),
+    };
+    // cells of at least the cutoff, at most ~ one per atom and 2^20 in all
+    let cap = (n.max(1) as f64).cbrt().ceil().clamp(1.0, 100.0);
+    let cells: [usize; 3] = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / cutoff).floor()).clamp(1.0, cap) as usize);
+    let size: [f64; 3] = [0, 1, 2].map(|k| (hi[k] - lo[k]) / cells[k] as f64);
+    let cell_of = |x: &crate::physics::V3| -> [usize; 3] {
+        [0, 1, 2].map(|k| if size[k] > 0.0 { (((x[k] - lo[k]) / size[k]).floor().max(0.0) as usize).min(cells[k] - 1) } else { 0 })
+    };
+    let flat = |c: [usize; 3]| (c[2] * cells[1] + c[1]) * cells[0] + c[0];
+    // atoms by cell (counting sort)
+    let mut start = vec![0usize; cells[0] * cells[1] * cells[2] + 1];
+    let own: Vec<usize> = p.x.iter().map(|x| flat(cell_of(x))).collect();
+    for &c in &own {
+        start[c + 1] += 1;
+    }
+    for c in 1..start.len() {
+        start[c] += start[c - 1];
+    }
+    let mut fill = start.clone();
+    let mut atoms = vec![0usize; n];
+    for (i, &c) in own.iter().enumerate() {
+        atoms[fill[c]] = i;
+        fill[c] += 1;
+    }
+    // the distinct cells next to cell c along one side
+    let around = |k: usize, c: usize| -> Vec<usize> {
+        let m = cells[k];
+        let mut v: Vec<usize> = if m <= 3 {
+            (0..m).collect()
+        } else if periodic[k] {
+            vec![(c + m - 1) % m, c, (c + 1) % m]
+        } else {
+            (c.saturating_sub(1)..=(c + 1).min(m - 1)).collect()
+        };
+        v.dedup();
+        v
+    };
+    let len = [0, 1, 2].map(|k| hi[k] - lo[k]);
+    let cut2 = cutoff * cutoff;
+    for i in 0..n {
+        if p.mask[i] & group == 0 {
+            continue;
+        }
+        let c = cell_of(&p.x[i]);
+        let mut count = 0u64;
+        for cz in around(2, c[2]) {
+            for cy in around(1, c[1]) {
+                for cx in around(0, c[0]) {
+                    let f = flat([cx, cy, cz]);
+                    for &j in &atoms[start[f]..start[f + 1]] {
+                        if j == i || p.kind[j] < types.0 || p.kind[j] > types.1 {
+                            continue;
+                        }
+                        let mut d = p.x[i] - p.x[j];
+                        for k in 0..3 {
+                            if periodic[k] && len[k] > 0.0 {
+                                d[k] -= len[k] * (d[k] / len[k]).round();
+                            }
+                        }
+                        if d.norm_squared() < cut2 {
+                            count += 1;
+                        }
+                    }
+                }
+            }
+        }
+        out[i] = count as f64;
+    }
+    out
 }
 
 fn split_index(s: &str) -> (&str, Option<usize>) {

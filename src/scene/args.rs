@@ -118,3 +118,26 @@ pub fn bad_keyword(w: &Word, what: &str, choices: &[&str]) -> Error {
     }
     e
 }
+
+/// An atom type or range (`2`, `1*3`, `*`, `2*`) within 1..=ntypes.
+pub fn type_range(w: &Word, ntypes: u32) -> Result<(u32, u32)> {
+    let t = w.text.as_str();
+    let parse = |x: &str, d: u32| -> Result<u32> {
+        if x.is_empty() {
+            Ok(d)
+        } else {
+            x.parse::<u32>().map_err(|_| Error::deck(w.span, format!("bad atom type '{}'", w.text)))
+        }
+    };
+    let (lo, hi) = match t.find('*') {
+        Some(k) => (parse(&t[..k], 1)?, parse(&t[k + 1..], ntypes)?),
+        None => {
+            let v = parse(t, 1)?;
+            (v, v)
+        }
+    };
+    if lo < 1 || hi > ntypes || lo > hi {
+        return Err(Error::deck(w.span, format!("atom type '{}' out of range 1..{}", w.text, ntypes)));
+    }
+    Ok((lo, hi))
+}

@@ -403,8 +403,8 @@ pub fn execute(s: &mut Session, cmd: &Command) -> Result<()> {
         spec.has_coeff = true;
         if spec.normal.is_lammps_granular() {
             let ntypes = s.sim.ntypes.max(1) as u32;
-            let (ilo, ihi) = type_range(ti, ntypes)?;
-            let (jlo, jhi) = type_range(tj, ntypes)?;
+            let (ilo, ihi) = super::args::type_range(ti, ntypes)?;
+            let (jlo, jhi) = super::args::type_range(tj, ntypes)?;
             let (normal, tang, roll, pp) = parse_granular_coeff(&mut a)?;
             // demx runs one granular sub-model per scene
             let first = spec.granular.is_empty();
@@ -495,28 +495,6 @@ pub fn execute(s: &mut Session, cmd: &Command) -> Result<()> {
     }
     s.pair = Some(spec);
     Ok(())
-}
-
-fn type_range(w: &Word, ntypes: u32) -> Result<(u32, u32)> {
-    let t = w.text.as_str();
-    let parse = |x: &str, d: u32| -> Result<u32> {
-        if x.is_empty() {
-            Ok(d)
-        } else {
-            x.parse::<u32>().map_err(|_| Error::deck(w.span, format!("bad atom type '{}'", w.text)))
-        }
-    };
-    let (lo, hi) = match t.find('*') {
-        Some(k) => (parse(&t[..k], 1)?, parse(&t[k + 1..], ntypes)?),
-        None => {
-            let v = parse(t, 1)?;
-            (v, v)
-        }
-    };
-    if lo < 1 || hi > ntypes || lo > hi {
-        return Err(Error::deck(w.span, format!("atom type '{}' out of range 1..{}", w.text, ntypes)));
-    }
-    Ok((lo, hi))
 }
 
 /// LIGGGHTS `model M tangential T cohesion C rolling_friction R surface S kw v`.

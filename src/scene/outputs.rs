@@ -217,6 +217,7 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
                 if w.text.starts_with("v_") || w.text.starts_with("f_") {
                     return Err(Error::unsupported(w.span, format!("compute reduce of {}", w.text)));
                 }
+                uncomputed(s, w, "compute reduce of")?;
                 inputs.push(w.text.clone());
             }
             ComputeKind::Reduce { mode: mode.text.clone(), inputs }
@@ -268,6 +269,30 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
             }
             ComputeKind::ContactAtom
         }
+        // LIGGGHTS 3.8's form: a cutoff, then type ranges (one column each)
+        "coord/atom" => {
+            let cutoff = a.f64("coord/atom cutoff")?;
+            if !(cutoff > 0.0) || !cutoff.is_finite() {
+                return Err(a.err_prev(format!("compute coord/atom: cutoff must be positive, not {cutoff}")));
+            }
+            let ntypes = s.sim.ntypes.max(1) as u32;
+            let mut types = vec![];
+            while a.more() {
+                let w = a.word("type range")?;
+                if w.text == "group" || w.text == "cstyle" || w.text == "orientorder/atom" {
+                    return Err(Error::unsupported(w.span, format!("compute coord/atom keyword {} (a later LAMMPS's)", w.text)));
+                }
+                let (lo, hi) = super::args::type_range(w, ntypes)?;
+                types.push((lo, hi));
+            }
+            if types.is_empty() {
+                types.push((1, ntypes));
+            }
+            ComputeKind::CoordAtom { cutoff, types }
+        }
+        // defined by decks that never read it (a deck reading it stops
+        // there with exit 3: see `uncomputed`)
+        "stress/atom" => ComputeKind::Other(style.text.clone()),
         other => {
             return Err(Error::unsupported(style.span, format!("compute {other}")));
         }
@@ -278,6 +303,19 @@ fn compute_command(s: &mut Session, a: &mut Args) -> Result<()> {
         None => s.sim.computes.push(c),
     }
     Ok(())
+}
+
+/// A `c_ID` reference to a compute demx defines but does not compute yet
+/// (`ComputeKind::Other`): exit 3 where it is read.
+fn uncomputed(s: &Session, w: &crate::script::Word, what: &str) -> Result<()> {
+    let Some(rest) = w.text.strip_prefix("c_") else {
+        return Ok(());
+    };
+    let cid = rest.split('[').next().unwrap_or("");
+    match s.sim.computes.iter().find(|c| c.id == cid).map(|c| &c.kind) {
+        Some(ComputeKind::Other(style)) => Err(Error::unsupported(w.span, format!("{what} {} (compute {style} is not computed yet)", w.text))),
+        _ => Ok(()),
+    }
 }
 
 fn is_atom_property_name(n: &str) -> bool {
@@ -675,6 +713,7 @@ fn dump_command(s: &mut Session, cmd: &Command, a: &mut Args, one_off: bool) -> 
                     if !s.sim.computes.iter().any(|c| c.id == cid) {
                         return Err(Error::deck(w.span, format!("dump custom: compute '{cid}' does not exist")));
                     }
+                    uncomputed(s, w, "dump custom column")?;
                 }
                 cols.push(t.to_string());
             }

@@ -127,3 +127,37 @@ fix g all gravity 9.81 vector 0 0 -1\nregion fast block 0.0015 0.0025 INF INF IN
 velocity all set 0.1 0 -0.5\ngroup fast region fast\nvelocity fast set 0 0.2 -0.8\nfix 1 all nve/sphere\ntimestep 1e-6\n{tail}"
     )
 }
+
+/// 320 beads (d = 1 mm) on an fcc lattice falling onto a floor, periodic in
+/// x and y, of `ntypes` types (all type 1 at creation), a LIGGGHTS deck up
+/// to the integrator; `tail` follows it (computes, outputs, the run).
+pub fn settling_beads(ntypes: usize, tail: &str) -> String {
+    let per_type = |v: &str| vec![v; ntypes].join(" ");
+    let per_pair = |v: &str| format!("{ntypes} {}", vec![v; ntypes * ntypes].join(" "));
+    format!(
+        "atom_style granular\natom_modify map array\nboundary p p f\nnewton off\ncommunicate single vel yes\nunits si\n\
+region box block 0 0.006 0 0.006 0 0.02 units box\ncreate_box {ntypes} box\nneighbor 0.0002 bin\nneigh_modify delay 0\n\
+fix m1 all property/global youngsModulus peratomtype {}\nfix m2 all property/global poissonsRatio peratomtype {}\n\
+fix m3 all property/global coefficientRestitution peratomtypepair {}\nfix m4 all property/global coefficientFriction peratomtypepair {}\n\
+pair_style gran model hertz tangential history\npair_coeff * *\ntimestep 0.000005\nfix gravi all gravity 9.81 vector 0.0 0.0 -1.0\n\
+fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0\nlattice fcc 0.0015\n\
+region pts block 0 0.006 0 0.006 0.0006 0.008 units box\ncreate_atoms 1 region pts\nset group all diameter 0.001 density 2500\n\
+fix integr all nve/sphere\n{tail}",
+        per_type("5.e6"),
+        per_type("0.45"),
+        per_pair("0.3"),
+        per_pair("0.5"),
+    )
+}
+
+/// The frames of dump `name` of both runs of `b`, equal atom by atom
+/// (panics naming the step where they differ); the engine's frames.
+pub fn same_dump_frames(b: &Both, name: &str) -> BTreeMap<i64, BTreeMap<i64, Vec<f64>>> {
+    let theirs = dump_frames(&b.theirs.path().join(name));
+    let ours = dump_frames(&b.ours.path().join(name));
+    assert_eq!(theirs.keys().collect::<Vec<_>>(), ours.keys().collect::<Vec<_>>(), "the same frames of {name}");
+    for (step, rows) in &theirs {
+        assert_eq!(rows, &ours[step], "step {step}: {name} differs atom by atom");
+    }
+    theirs
+}

@@ -22,6 +22,7 @@ mod compare_heap;
 mod contact_atom;
 mod convert_corpus;
 mod convert_insert;
+mod coord_atom;
 mod displace_atom;
 mod engine_analytic;
 mod engine_incline;
