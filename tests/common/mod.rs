@@ -112,19 +112,29 @@ facet normal 0 0 1\nouter loop\nvertex 0 0 {z}\nvertex 0.004 0.004 {z}\nvertex 0
 /// different times with friction in x and y. `meshes` are fix lines put
 /// before the wall, `tail` everything after the time step.
 pub fn plate_deck(cad_args: &str, meshes: &str, tail: &str) -> String {
+    let atoms = "lattice sc 0.001\nregion grains block 0.0005 0.0035 0.0005 0.0035 0.0005 0.0015 units box\ncreate_atoms 1 region grains\n\
+set group all diameter 0.0009 density 2500\n";
     format!(
-        "units si\natom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\n\
-region box block -0.001 0.005 -0.001 0.005 -0.001 0.004 units box\ncreate_box 1 box\nlattice sc 0.001\n\
-region grains block 0.0005 0.0035 0.0005 0.0035 0.0005 0.0015 units box\ncreate_atoms 1 region grains\n\
-set group all diameter 0.0009 density 2500\n\
-fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
-fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
-fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
-pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\n\
-fix cad all mesh/surface/stress file plate.stl type 1{cad_args}\n{meshes}\
+        "{}fix cad all mesh/surface/stress file plate.stl type 1{cad_args}\n{meshes}\
 fix wall all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
 fix g all gravity 9.81 vector 0 0 -1\nregion fast block 0.0015 0.0025 INF INF INF INF units box\n\
-velocity all set 0.1 0 -0.5\ngroup fast region fast\nvelocity fast set 0 0.2 -0.8\nfix 1 all nve/sphere\ntimestep 1e-6\n{tail}"
+velocity all set 0.1 0 -0.5\ngroup fast region fast\nvelocity fast set 0 0.2 -0.8\nfix 1 all nve/sphere\ntimestep 1e-6\n{tail}",
+        hertz_grains("-0.001 0.005 -0.001 0.005 -0.001 0.004", atoms, 0.5)
+    )
+}
+
+/// The opening of a LIGGGHTS deck of one atom type in a fixed box (`bounds`:
+/// xlo xhi ylo yhi zlo zhi, m): `atoms` (the lines that create and size the
+/// grains), then Y = 1e7, nu = 0.3, the given restitution, friction 0.5,
+/// Hertz with tangential history, neighbor 0.2 mm.
+pub fn hertz_grains(bounds: &str, atoms: &str, restitution: f64) -> String {
+    format!(
+        "units si\natom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\n\
+region box block {bounds} units box\ncreate_box 1 box\n{atoms}\
+fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
+fix m3 all property/global coefficientRestitution peratomtypepair 1 {restitution}\n\
+fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
+pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\n"
     )
 }
 

@@ -6,22 +6,16 @@
 use crate::common;
 
 fn deck() -> String {
-    "units si\natom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\n\
-region box block -0.001 0.008 -0.001 0.005 0 0.007 units box\ncreate_box 1 box\nlattice sc 0.001\n\
-region grains block 0.0005 0.0065 0.0005 0.0035 0.004 0.0045 units box\ncreate_atoms 1 region grains\n\
-set group all diameter 0.0006 density 2500\n\
-fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
-fix m3 all property/global coefficientRestitution peratomtypepair 1 0.9\n\
-fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
-pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\n\
-fix face all mesh/surface file face.stl type 1\n\
+    let atoms = "lattice sc 0.001\nregion grains block 0.0005 0.0065 0.0005 0.0035 0.004 0.0045 units box\ncreate_atoms 1 region grains\n\
+set group all diameter 0.0006 density 2500\n";
+    common::hertz_grains("-0.001 0.008 -0.001 0.005 0 0.007", atoms, 0.9)
+        + "fix face all mesh/surface file face.stl type 1\n\
 fix floor all wall/gran model hertz tangential history primitive type 1 zplane 0.0\n\
 fix g all gravity 9.81 vector 0 0 -1\nfix 1 all nve/sphere\ntimestep 1e-5\n\
 fix many all massflow/mesh mesh face vec_side 0 0 -1 file many.txt writeTime\n\
 fix one all massflow/mesh mesh face vec_side 0 0 -1 count once\n\
 thermo_style custom step atoms f_many[1] f_many[2] f_many[3] f_many[4] f_one[2]\nthermo_modify format float %.15g\nthermo 500\n\
 run 9000\n"
-        .to_string()
 }
 
 #[test]

@@ -301,23 +301,18 @@ fn deep_wall_overlap_is_stopped_and_names_the_wall() {
 #[test]
 fn grains_placed_into_walls_run_as_liggghts_resolves_them() {
     use crate::common;
-    let deck = "units si\natom_style granular\natom_modify map array\nboundary f f f\nnewton off\ncommunicate single vel yes\n\
-region box block -0.001 0.009 -0.001 0.005 -0.002 0.05 units box\ncreate_box 1 box\n\
-create_atoms 1 single 0.001 0.001 0.0001 units box\ncreate_atoms 1 single 0.003 0.003 0.00003 units box\n\
+    let atoms = "create_atoms 1 single 0.001 0.001 0.0001 units box\ncreate_atoms 1 single 0.003 0.003 0.00003 units box\n\
 create_atoms 1 single 0.006 0.002 -0.00131 units box\ncreate_atoms 1 single 0.007 0.003 -0.001375 units box\n\
-set group all diameter 0.0009 density 2500\n\
-fix m1 all property/global youngsModulus peratomtype 1e7\nfix m2 all property/global poissonsRatio peratomtype 0.3\n\
-fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n\
-fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n\
-pair_style gran model hertz tangential history\npair_coeff * *\nneighbor 0.0002 bin\n\
-fix cad all mesh/surface file plate.stl type 1\n\
+set group all diameter 0.0009 density 2500\n";
+    let deck = common::hertz_grains("-0.001 0.009 -0.001 0.005 -0.002 0.05", atoms, 0.5)
+        + "fix cad all mesh/surface file plate.stl type 1\n\
 fix wall all wall/gran model hertz tangential history mesh n_meshes 1 meshes cad\n\
 fix floor all wall/gran model hertz tangential history primitive type 1 zplane -0.0014\n\
 fix g all gravity 9.81 vector 0 0 -1\nvelocity all set 0.01 0.02 0\nfix 1 all nve/sphere\ntimestep 1e-6\n\
 thermo 500\nthermo_style custom step atoms ke\n\
 dump d all custom 500 dump.walls id x y z vx vy vz\ndump_modify d format \"%d %.17g %.17g %.17g %.17g %.17g %.17g\"\n\
 run 3000\n";
-    let b = common::engine_and_demx("liggghts", "in.walls", &[("in.walls", deck), ("plate.stl", &common::plate_stl("0"))]);
+    let b = common::engine_and_demx("liggghts", "in.walls", &[("in.walls", &deck), ("plate.stl", &common::plate_stl("0"))]);
     assert_eq!(b.ours_out.matches("WARNING (demx): stability guard: ").count(), 1, "{}", b.ours_out);
     assert!(b.ours_out.contains("overlaps wall (fix "), "{}", b.ours_out);
     let (theirs, ours) = (common::dump_frames(&b.theirs.path().join("dump.walls")), common::dump_frames(&b.ours.path().join("dump.walls")));
